@@ -1,0 +1,1 @@
+namespace fissure::host {}  // the host_sim issue fills this module

@@ -1,0 +1,1 @@
+namespace fissure::rt {}  // the rt_core issue fills this module

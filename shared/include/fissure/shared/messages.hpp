@@ -1,0 +1,106 @@
+#pragma once
+// The messages rt_core and host_sim exchange (BRIEF §2). Fixed size, trivially copyable,
+// layout pinned by static_assert so that the in-process exchange, the wire codec and a
+// memcpy all agree. SI units everywhere; every vector names its frame:
+//   *_device : the Falcon's kinematic frame (libnifalcon's): origin at the centre of the
+//              base, z pointing out of the device towards the user, y up, x to the right.
+//   *_world  : the scene's frame (host_sim, Bullet), y up.
+// The device→world mapping (scale, offset, axis permutation, clamp mode) is part of the
+// session configuration and applied by rt_core; the host receives device-frame samples.
+//
+// Changing any struct below changes its size or meaning: bump kProtocolVersion.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <type_traits>
+
+#include <Eigen/Core>
+
+#include "fissure/shared/time.hpp"
+
+namespace fissure {
+
+/// Version of the layouts below and of the wire codec built on them. The transport
+/// handshake refuses a peer with a different version (naming both).
+inline constexpr std::uint16_t kProtocolVersion = 1;
+
+/// One patch per tool face or jaw is enough for the paper's tools (spatula: 2 faces,
+/// clamp: 2 jaws × 2 faces); 8 leaves room for a convex tool's rim.
+inline constexpr std::size_t kMaxContactPatches = 8;
+
+using Vec3 = std::array<double, 3>;
+using Quat = std::array<double, 4>;  // unit quaternion, (w, x, y, z)
+
+inline Eigen::Map<const Eigen::Vector3d> as_eigen(const Vec3& v) noexcept { return Eigen::Map<const Eigen::Vector3d>(v.data()); }
+inline Eigen::Map<Eigen::Vector3d> as_eigen(Vec3& v) noexcept { return Eigen::Map<Eigen::Vector3d>(v.data()); }
+inline Vec3 to_vec3(const Eigen::Vector3d& v) noexcept { return {v.x(), v.y(), v.z()}; }
+
+/// Device status and fault bits carried in DeviceState::status_flags.
+enum DeviceStatusBits : std::uint32_t {
+  kDeviceHomed = 1u << 0,            ///< all three arms report homed
+  kDeviceSimulated = 1u << 1,        ///< the sample comes from SimFalcon, not USB
+  kDeviceFaultTimeout = 1u << 8,     ///< no reply within the I/O deadline
+  kDeviceFaultDisconnected = 1u << 9,///< USB device gone / transport closed
+  kDeviceFaultTornPacket = 1u << 10, ///< reply failed to parse this tick (resynchronising)
+  kDeviceFaultEncoderJump = 1u << 11,///< encoder moved faster than the mechanism can
+  kDeviceFaultNonFinite = 1u << 12,  ///< kinematics produced NaN/inf or did not converge
+  kDeviceFaultMask = 0xFFFFu << 8,
+};
+
+/// One sample of the haptic device as rt_core saw it (rt_core → host_sim, and telemetry).
+struct DeviceState {
+  std::uint64_t sequence = 0;        ///< +1 per published sample; gaps mean lost samples
+  TimeNs sample_time_ns = 0;         ///< when the encoders were read (shared timeline)
+  Vec3 position_device_m{};          ///< end-effector position, device frame [m]
+  Vec3 velocity_device_m_per_s{};    ///< filtered end-effector velocity, device frame [m/s]
+  double closing_axis_m = 0.0;       ///< clamp mode: displacement along the mapped closing axis [m]
+  std::uint32_t buttons = 0;         ///< bit i = grip button i pressed (Falcon: 4 buttons)
+  std::uint32_t status_flags = 0;    ///< DeviceStatusBits
+};
+static_assert(std::is_trivially_copyable_v<DeviceState>);
+static_assert(sizeof(DeviceState) == 80);
+static_assert(offsetof(DeviceState, position_device_m) == 16);
+static_assert(offsetof(DeviceState, buttons) == 72);
+
+/// Which rigid part of the tool a patch acts on; the clamp's jaws get separate force sums.
+enum class ToolPart : std::uint32_t { kTool = 0, kJawA = 1, kJawB = 2 };
+
+/// A local model of one contact region (BRIEF §5): a plane that moves with the soft
+/// surface, and the Hunt-Crossley law that reproduces the host's force for that region.
+/// rt_core evaluates it against the *current* tool position p_tool_world:
+///   x = (plane_point_world_m − p_tool_world) · normal_world   (penetration, m)
+///   F = max(0, k·xⁿ + λ·xⁿ·ẋ) · normal_world  for x > 0, else 0
+struct ContactPatch {
+  Vec3 plane_point_world_m{};        ///< a point on the zero-penetration plane, world frame [m]
+  Vec3 normal_world{};               ///< unit normal, world frame: direction of the force on the tool
+  double stiffness_k = 0.0;          ///< Hunt-Crossley k [N/mⁿ]
+  double damping_lambda = 0.0;       ///< Hunt-Crossley λ [N·s/m⁽ⁿ⁺¹⁾]
+  double exponent_n = 1.0;           ///< Hunt-Crossley n [-], 1 (flat punch) … 2
+  Vec3 reference_tool_position_world_m{};  ///< tool origin when the host built the patch [m]
+  Quat reference_tool_orientation_world{1.0, 0.0, 0.0, 0.0};  ///< tool orientation then
+  TimeNs reference_time_ns = 0;      ///< host simulation time of that tool pose
+  ToolPart tool_part = ToolPart::kTool;
+  std::uint32_t reserved = 0;        ///< zero; keeps the layout 8-byte aligned
+};
+static_assert(std::is_trivially_copyable_v<ContactPatch>);
+static_assert(sizeof(ContactPatch) == 144);
+
+enum ContactProxyBits : std::uint32_t {
+  kProxyValid = 1u << 0,             ///< host asserts the content is usable
+  kProxyHostInContact = 1u << 1,     ///< host saw contact at the reference pose
+};
+
+/// The contact proxy host_sim publishes after each step (host_sim → rt_core).
+struct ContactProxy {
+  std::uint64_t sequence = 0;        ///< +1 per host step that published
+  TimeNs host_time_ns = 0;           ///< host simulation time of the step
+  std::uint16_t protocol_version = kProtocolVersion;
+  std::uint16_t patch_count = 0;     ///< patches[0, patch_count) are meaningful
+  std::uint32_t flags = 0;           ///< ContactProxyBits
+  std::array<ContactPatch, kMaxContactPatches> patches{};
+};
+static_assert(std::is_trivially_copyable_v<ContactProxy>);
+static_assert(offsetof(ContactProxy, patches) == 24);
+static_assert(sizeof(ContactProxy) == 24 + kMaxContactPatches * sizeof(ContactPatch));
+
+}  // namespace fissure
