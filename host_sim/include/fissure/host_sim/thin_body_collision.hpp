@@ -1,0 +1,116 @@
+#pragma once
+// Paired-node thin-body collision (BRIEF §3; the paper's core) and its ray-only variant.
+//
+// Call order (the world owns it): every host step
+//   1. move the tool's kinematic body to `current` and call world.stepSimulation(dt, 1, dt)
+//      (ONE Bullet substep per collision step — the soft body's btSoftBody::Node::m_q then holds
+//      each node's position at the start of the step, which the sweep uses; keep
+//      m_cfg.diterations = 0, Bullet's default, because drift iterations overwrite m_q);
+//   2. collision.step(previous, current, dt, soft, result): detects, writes enforced
+//      displacements into soft.m_nodes[i].m_x / m_v, and computes the Hunt-Crossley force.
+// The tool's rigid body must NOT also collide with the soft body through Bullet (no SDF_RS contact
+// between them) for the paired / ray methods.
+#include <fissure/host_sim/thin_tool.hpp>
+
+#include <Eigen/Core>
+
+#include <memory>
+#include <vector>
+
+class btSoftBody;
+
+namespace fissure::host {
+
+enum class CollisionMethod { kPaired, kRay, kBullet };
+
+// F = k·xⁿ + λ·xⁿ·ẋ for x ≥ 0, clamped to F ≥ 0 (BRIEF §4; Hunt & Crossley 1975), one term per
+// deformed triangle with at least one colliding node, x = |centroid − rest centroid|.
+struct HuntCrossleyParams {
+  double k = 2.0e5;       // per_unit_area: N/m^(n+2) (× rest area m² → N/mⁿ); else N/mⁿ per triangle
+  double lambda = 50.0;   // per_unit_area: N·s/m^(n+3); else N·s/m^(n+1) per triangle
+  double n = 1.5;         // exponent (1 flat punch, 3/2 Hertz)
+  // true (default): k and λ per unit area, each triangle weighted by its rest area, so refining the
+  // mesh converges the force; false: the paper's plain per-triangle sum.
+  bool per_unit_area = true;
+};
+
+struct ThinBodyCollisionParams {
+  HuntCrossleyParams hunt_crossley;
+  // Gap left between a displaced soft node and the tool face (keeps nodes strictly outside the
+  // tool in float precision; Bullet's soft body here is single precision).
+  double skin_m = 2.0e-5;
+  // A tool node within this distance in front of a soft triangle counts as touching it (keeps a
+  // resting contact from flickering at slow speeds).
+  double contact_distance_m = 5.0e-5;
+  // ẋ is a finite difference of x filtered by a first-order low-pass with this cut-off
+  // (time constant 1/(2π·fc), i.e. ≈1.6 ms lag at 100 Hz).
+  double velocity_filter_cutoff_hz = 100.0;
+  // Broad-phase inflation of the swept tool bounds (covers soft motion within a step).
+  double broad_phase_margin_m = 0.005;
+  // Reported in ContactRecord::jaw so that a clamp can run one instance per jaw.
+  int jaw = 0;
+};
+
+// One contacted soft triangle (what the proxy builder needs: a plane per contact, which tool face
+// / jaw it is on, and this triangle's share of the force).
+struct ContactRecord {
+  int soft_face = -1;                 // index into btSoftBody::m_faces
+  int tool_node = -1;                 // leading tool node (-1: contact found by the soft-node guard)
+  int tool_plane = -1;                // tool face (index into ToolNodes::planes()) the triangle lies on
+  int jaw = 0;                        // ThinBodyCollisionParams::jaw
+  Eigen::Vector3d point_world_m = Eigen::Vector3d::Zero();   // triangle centroid after the response
+  Eigen::Vector3d normal_world = Eigen::Vector3d::Zero();    // tool face outward normal (world)
+  double penetration_m = 0.0;         // HC deformation x: |centroid − rest centroid|
+  double penetration_rate_m_s = 0.0;  // filtered ẋ
+  double weight = 1.0;                // rest area (m²) in per-unit-area mode, 1 otherwise
+  double force_n = 0.0;               // this triangle's HC force magnitude (≥ 0)
+};
+
+struct CollisionStepResult {
+  Eigen::Vector3d force_on_tool_world_n = Eigen::Vector3d::Zero();
+  std::vector<ContactRecord> contacts;  // reserved once by reserve_for(), reused (no allocation)
+  int colliding_tool_nodes = 0;   // tool nodes in contact after the exclusion
+  int excluded_pairs = 0;         // tool nodes excluded as the non-leading node of a pair in contact
+  int both_face_contacts = 0;     // pairs with both nodes pushing (always 0 for paired; ray's instability)
+  int contacted_triangles = 0;
+  int displaced_soft_nodes = 0;   // soft nodes written by the enforced displacement
+  int guard_corrections = 0;      // soft nodes the swept soft-node guard had to put back (paired only)
+  bool broad_phase_hit = false;
+  double seconds_broad = 0.0;
+  double seconds_narrow = 0.0;
+  double seconds_response = 0.0;
+  double seconds_force = 0.0;
+
+  // Reserve capacity for a soft body with this many faces (call once, before the loop).
+  void reserve_for(int soft_face_count) { contacts.reserve(static_cast<std::size_t>(soft_face_count)); }
+};
+
+class ThinBodyCollision {
+ public:
+  virtual ~ThinBodyCollision();
+  ThinBodyCollision() = default;
+  ThinBodyCollision(const ThinBodyCollision&) = delete;
+  ThinBodyCollision& operator=(const ThinBodyCollision&) = delete;
+
+  // One collision step (see the call order above). `soft` must be the body given at
+  // construction. Does not allocate once `out.reserve_for(faces)` has been called.
+  virtual void step(const ToolPose& previous, const ToolPose& current, double dt_s, btSoftBody& soft,
+                    CollisionStepResult& out) = 0;
+  // Re-take the rest state (rest centroids for x) from the body's current positions, e.g. after
+  // letting it settle under gravity, so that x = 0 at the settled shape.
+  virtual void reset_rest_state(const btSoftBody& soft) = 0;
+  [[nodiscard]] virtual CollisionMethod method() const = 0;
+};
+
+// The soft body must have triangle faces (btSoftBody::m_faces); its rest state (rest centroids,
+// rest areas) is taken from its positions now. The closed-surface orientation (outward normals) is
+// detected from the signed volume; an open sheet's outward side is the side its face normals
+// (Bullet's winding) point to. Throws std::invalid_argument on a body without faces.
+std::unique_ptr<ThinBodyCollision> make_paired_collision(const ToolNodes& tool, const btSoftBody& soft,
+                                                         const ThinBodyCollisionParams& params);
+// The same detection without the pairing / exclusion step and without the soft-node side memory:
+// every tool node in contact places its triangle on its own face (paper Fig. 3 right).
+std::unique_ptr<ThinBodyCollision> make_ray_collision(const ToolNodes& tool, const btSoftBody& soft,
+                                                      const ThinBodyCollisionParams& params);
+
+}  // namespace fissure::host
