@@ -8,14 +8,17 @@
 // y up, z out of the device toward the user. Metres, radians.
 //
 // Workspace. The *reachable* region is where every arm's closed-form IK has a real
-// solution on the Falcon's assembly branch with the arm kept away from its singular
-// configurations (sin θ3 ≥ kMinSinTheta3, sin(θ2 − θ1) ≥ kMinSinKnee); inverse_kinematics()
-// reports failure outside it. The documented *workspace* (in_workspace()) is the ball of
-// radius kWorkspaceRadius_m = 5 cm around kWorkspaceCentre_device_m = (0, 0, 0.125) m —
-// the Falcon's advertised ~10 cm reach. It lies wholly inside the reachable region with
-// sin(θ2 − θ1) ≥ 0.3 and sin θ3 ≥ 0.7 on every arm (tests check this), so the Jacobian is
-// well conditioned everywhere in it. The whole ball of radius 5 cm fits only around
-// z ≈ 0.12–0.125 m; the cube |x|,|y| ≤ 5 cm, z ∈ [7.5, 17.5] cm is NOT fully reachable.
+// solution on the Falcon's assembly branch — upper arm in front of the base (|θ1| < 90°),
+// end effector in front of the base (z > 0) — with the arm kept away from its singular
+// configurations (sin θ3 ≥ kMinSinTheta3, sin(θ2 − θ1) ≥ kMinSinKnee). inverse_kinematics()
+// reports failure outside it. It is a purely geometric region and somewhat larger than
+// what the real device's mechanical stops allow. The documented *workspace* (in_workspace())
+// is the ball of radius kWorkspaceRadius_m = 5 cm around kWorkspaceCentre_device_m =
+// (0, 0, 0.125) m — the Falcon's advertised ~10 cm reach. It lies wholly inside the reachable
+// region with sin(θ2 − θ1) ≥ 0.45 and sin θ3 ≥ 0.85 on every arm and θ1 ∈ [−35°, 82°]
+// (tests check the margins), so the Jacobian is well conditioned everywhere in it. A 5 cm
+// ball fits with these margins only around z ≈ 0.12–0.125 m on the axis; the cube
+// |x|,|y| ≤ 5 cm, z ∈ [7.5, 17.5] cm is NOT fully reachable (its corners fail IK).
 #include <array>
 
 #include <Eigen/Core>
@@ -42,8 +45,8 @@ struct ArmAngles {
   double theta3_rad = 0.0;
 };
 
-/// Closed-form IK for all joints of all arms. False (outputs untouched... or partially
-/// written, never NaN) when p is non-finite or outside the reachable region.
+/// Closed-form IK for all joints of all arms. False, arms unchanged, when p is non-finite
+/// or outside the reachable region.
 bool arm_angles(const FalconGeometry& geometry, const Eigen::Vector3d& p_device_m,
                 std::array<ArmAngles, 3>& arms) noexcept;
 
@@ -68,8 +71,9 @@ bool jacobian(const FalconGeometry& geometry, const Eigen::Vector3d& p_device_m,
 /// (|∂p/∂θ| ≈ 0.08 m/rad), far below a 1 µm target and the encoder's 6.4e-4 rad step,
 /// and costs at most one more Newton step than 1e-6 (quadratic convergence; see bench).
 inline constexpr double kDefaultFkTolerance_rad = 1e-9;
-/// Newton iterations allowed: warm starts from the previous 1 kHz sample need 2–3, cold
-/// starts from the workspace centre need ≲ 10 (bench kinematics reports the distribution).
+/// Newton iterations allowed: warm starts from the previous 1 kHz sample need ≤ 2 at the
+/// default tolerance, cold starts from the workspace centre ≤ 6 over the whole workspace
+/// (tests; `fissure bench kinematics` reports the distribution). Only unreachable θ use them all.
 inline constexpr int kDefaultFkMaxIterations = 30;
 
 struct FkOptions {
@@ -85,9 +89,11 @@ struct FkResult {
 
 /// Forward kinematics: damped Newton on IK(p) − θ = 0 with the analytic ∂θ/∂p, starting
 /// from p_device_m (the previous solution: warm start). Backtracking line search on the
-/// residual and a step-length limit keep it inside the reachable region. p_device_m is
-/// always left at a point where IK succeeds (or unchanged if the start itself fails).
-/// If the warm start is not in the reachable region, starts from the workspace centre.
+/// residual and a step-length limit keep it inside the reachable region; the residual
+/// never grows. If the warm start is not reachable (first tick, after a fault: NaN, 0)
+/// it starts from the workspace centre. On return p_device_m is the best point found (a
+/// reachable point, never NaN). Worst-case cost is bounded: max_iterations Newton steps,
+/// each at most 21 IK evaluations (step halvings).
 FkResult forward_kinematics(const FalconGeometry& geometry, const Eigen::Vector3d& theta_rad,
                             Eigen::Vector3d& p_device_m, const FkOptions& options) noexcept;
 

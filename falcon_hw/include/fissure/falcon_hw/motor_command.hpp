@@ -24,7 +24,7 @@ inline constexpr double kMotorCountSignPerTorque = -1.0;
 struct MotorCommandResult {
   std::array<std::int16_t, 3> counts{};
   bool saturated = false;   ///< the ±kMaxMotorCount clamp scaled the command down
-  bool non_finite = false;  ///< NaN/inf in J, F or gain, or gain ≤ 0: counts are zero
+  bool non_finite = false;  ///< NaN/inf in J, F or gain, gain ≤ 0, or unrepresentable: counts are zero
 };
 
 /// counts = sign · τ / newton_metre_per_count, τ = dp_dthetaᵀ · force_device_n; if any
