@@ -11,9 +11,11 @@ for module in shared falcon_hw rt_core; do
     echo "dependency rule broken: $module/ must not include Bullet or host_sim:"; echo "$hits"; status=1
   fi
 done
-# shared/: every non-standard include must be Eigen or shared's own header.
-if hits=$(grep -rnE '#include *[<"]' "$root/shared" | grep -vE '#include *<[a-z_]+>|#include *<Eigen/|#include *"fissure/shared/'); then
-  echo "dependency rule broken: shared/ may include only the standard library, Eigen and itself:"; echo "$hits"; status=1
+# shared/: every non-standard include must be Eigen, a POSIX/Linux system header (the UDP and
+# SocketCAN carriers), or shared's own header.
+posix='#include *<(sys|net|netinet|arpa|linux|linux/can)/[a-z_]+\.h>|#include *<(unistd|fcntl|netdb|poll)\.h>'
+if hits=$(grep -rnE '#include *[<"]' "$root/shared" | grep -vE "#include *<[a-z_]+>|#include *<Eigen/|#include *\"fissure/shared/|$posix"); then
+  echo "dependency rule broken: shared/ may include only the standard library, Eigen, POSIX/Linux system headers and itself:"; echo "$hits"; status=1
 fi
 # rt_core/: nothing of the app layer (logging, CLI, JSON) in the RT library.
 if hits=$(grep -rnE '#include *[<"](spdlog|CLI/|nlohmann|toml)' "$root/rt_core" 2>/dev/null); then
