@@ -1,0 +1,68 @@
+#include "fissure/rt_core/rt_config.hpp"
+
+#include <cmath>
+
+#include "fissure/rt_core/device_mapping.hpp"
+
+namespace fissure::rt {
+namespace {
+
+bool positive(double x) noexcept { return std::isfinite(x) && x > 0.0; }
+bool non_negative(double x) noexcept { return std::isfinite(x) && x >= 0.0; }
+
+}  // namespace
+
+const char* check_config(const RtConfig& c) noexcept {
+  if (!(std::isfinite(c.rate_hz) && c.rate_hz >= kMinRate_hz && c.rate_hz <= kMaxRate_hz)) {
+    return "rate_hz must be in [500, 10000] Hz";
+  }
+  if (!is_valid(c.mapping)) {
+    return "mapping: axis_permutation must permute {0,1,2}, axis_sign be ±1, scale > 0, force_scale ≥ 0, "
+           "closing_axis_world in 0..2, offsets finite";
+  }
+  if (!std::isfinite(c.kinematics.encoder.radians_per_count) || c.kinematics.encoder.radians_per_count == 0.0 ||
+      !std::isfinite(c.kinematics.encoder.offset_rad)) {
+    return "kinematics.encoder: radians_per_count must be finite and non-zero, offset_rad finite";
+  }
+  if (!positive(c.kinematics.newton_metre_per_count)) return "kinematics.newton_metre_per_count must be > 0";
+  if (!positive(c.kinematics.fk.tolerance_rad) || c.kinematics.fk.max_iterations < 1) {
+    return "kinematics.fk: tolerance_rad must be > 0 and max_iterations ≥ 1";
+  }
+  if (!(positive(c.velocity.cutoff_hz) && c.velocity.cutoff_hz < 0.5 * c.rate_hz)) {
+    return "velocity.cutoff_hz must be in (0, rate_hz/2)";
+  }
+  if (!positive(c.proxy.blend_max_step_n)) return "proxy.blend_max_step_n must be > 0";
+  if (!positive(c.proxy.stale_after_s)) return "proxy.stale_after_s must be > 0";
+  if (!non_negative(c.proxy.fade_s)) return "proxy.fade_s must be ≥ 0";
+  if (!non_negative(c.passivity.max_damping_n_s_per_m)) return "passivity.max_damping_n_s_per_m must be ≥ 0";
+  if (!positive(c.passivity.min_speed_m_per_s)) return "passivity.min_speed_m_per_s must be > 0";
+  if (!(positive(c.safety.max_force_n) && c.safety.max_force_n <= kFalconMaxForce_n)) {
+    return "safety.max_force_n must be in (0, 8] N (the Falcon's rating)";
+  }
+  if (!positive(c.safety.max_force_rate_n_per_s)) return "safety.max_force_rate_n_per_s must be > 0";
+  if (!c.safety.workspace_centre_device_m.allFinite() || !positive(c.safety.workspace_radius_m)) {
+    return "safety.workspace_centre_device_m must be finite and workspace_radius_m > 0";
+  }
+  if (!non_negative(c.safety.soft_wall_stiffness_n_per_m)) return "safety.soft_wall_stiffness_n_per_m must be ≥ 0";
+  if (!non_negative(c.safety.ramp_in_s) || !non_negative(c.safety.ramp_out_s) ||
+      !non_negative(c.safety.fault_ramp_in_s)) {
+    return "safety.ramp_in_s, ramp_out_s and fault_ramp_in_s must be ≥ 0";
+  }
+  if (!positive(c.faults.max_joint_rate_rad_per_s)) return "faults.max_joint_rate_rad_per_s must be > 0";
+  if (c.faults.recovery_ticks < 0) return "faults.recovery_ticks must be ≥ 0";
+  return nullptr;
+}
+
+bool build_model(const RtConfig& config, RtModel& model, const char** error) noexcept {
+  const char* problem = check_config(config);
+  if (error != nullptr) *error = problem;
+  if (problem != nullptr) return false;
+  model.config = config;
+  model.period_ns = period_from_rate_hz(config.rate_hz);
+  model.period_s = to_seconds(model.period_ns);
+  model.velocity_filter = design_velocity_filter(config.velocity.cutoff_hz, config.rate_hz);
+  model.velocity_lag_s = velocity_lag_s(config.velocity.cutoff_hz, config.rate_hz);
+  return true;
+}
+
+}  // namespace fissure::rt

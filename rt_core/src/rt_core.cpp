@@ -1,1 +1,0 @@
-namespace fissure::rt {}  // the rt_core issue fills this module

@@ -1,0 +1,210 @@
+#include "fissure/rt_core/tick.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "fissure/rt_core/device_mapping.hpp"
+#include "fissure/rt_core/faults.hpp"
+#include "fissure/rt_core/forward_kinematics_stage.hpp"
+#include "fissure/rt_core/hunt_crossley.hpp"
+#include "fissure/rt_core/joint_angles.hpp"
+#include "fissure/rt_core/motor_command.hpp"
+#include "fissure/rt_core/passivity.hpp"
+#include "fissure/rt_core/proxy_blend.hpp"
+#include "fissure/rt_core/safety.hpp"
+#include "fissure/rt_core/staleness.hpp"
+#include "fissure/rt_core/velocity_filter.hpp"
+
+namespace fissure::rt {
+namespace {
+
+// Read device → encoder → angles → FK → velocity. Returns the device fault bits of this
+// tick (0: p_device_m / v_device_m_per_s hold a good sample).
+std::uint32_t read_device(const RtModel& model, RtData& data, falcon::HapticDevice& device, TimeNs now_ns) noexcept {
+  const RtConfig& config = model.config;
+  data.io_status = device.try_exchange(data.pending_command, data.reading);
+  if (data.io_status == falcon::IoStatus::kDisconnected) return kFaultDeviceDisconnected;
+  if (data.io_status != falcon::IoStatus::kOk) {
+    ++data.faults.io_errors;
+    return kFaultDeviceIo;
+  }
+  const double elapsed_s =
+      data.joints.have_reference ? to_seconds(now_ns - data.last_judged_sample_ns) : model.period_s;
+  data.last_judged_sample_ns = now_ns;
+  switch (encoders_to_joint_angles(config.kinematics.encoder, config.faults, data.joints, data.reading.encoder_counts,
+                                   std::max(elapsed_s, model.period_s))) {
+    case JointCheck::kJump:
+      ++data.faults.encoder_jumps;
+      return kFaultEncoderJump;
+    case JointCheck::kNonFinite:
+      ++data.faults.non_finite;
+      return kFaultNonFinite;
+    case JointCheck::kOk:
+      break;
+  }
+  if (!solve_position(config.kinematics.geometry, config.kinematics.fk, data.kinematics, data.joints.theta_rad)) {
+    ++data.faults.non_finite;
+    return kFaultNonFinite;
+  }
+  const Eigen::Vector3d v =
+      update_velocity(model.velocity_filter, data.velocity, data.kinematics.p_device_m, model.period_s);
+  if (!v.allFinite()) {
+    ++data.faults.non_finite;
+    return kFaultNonFinite;
+  }
+  data.p_device_m = data.kinematics.p_device_m;
+  data.v_device_m_per_s = v;
+  return 0;
+}
+
+// Device faults latch and clear after recovery_ticks clean ticks (disconnect never clears).
+void update_device_faults(const RtModel& model, RtData& data, std::uint32_t new_faults) noexcept {
+  FaultState& faults = data.faults;
+  if (new_faults != 0) {
+    faults.latched_device_faults |= new_faults;
+    faults.clean_ticks = 0;
+    // History is no longer trustworthy: restart the velocity filter and the observer's Δp
+    // chain from the next good sample.
+    data.velocity.primed = false;
+    restart_observer(data.passivity);
+    return;
+  }
+  if (faults.latched_device_faults == 0) return;
+  if (++faults.clean_ticks >= model.config.faults.recovery_ticks) {
+    faults.latched_device_faults &= kFaultDeviceDisconnected;
+  }
+}
+
+std::uint32_t to_device_status(const RtData& data, std::uint32_t fault_bits) noexcept {
+  std::uint32_t status = 0;
+  if ((data.reading.homed_mask & 0x7u) == 0x7u) status |= kDeviceHomed;
+  if (data.device_is_simulated) status |= kDeviceSimulated;
+  if (data.io_status == falcon::IoStatus::kTimeout || data.io_status == falcon::IoStatus::kNotRunning) {
+    status |= kDeviceFaultTimeout;
+  }
+  if (data.io_status == falcon::IoStatus::kTornPacket) status |= kDeviceFaultTornPacket;
+  if ((fault_bits & kFaultDeviceDisconnected) != 0u) status |= kDeviceFaultDisconnected;
+  if ((fault_bits & kFaultEncoderJump) != 0u) status |= kDeviceFaultEncoderJump;
+  if ((fault_bits & kFaultNonFinite) != 0u) status |= kDeviceFaultNonFinite;
+  return status;
+}
+
+}  // namespace
+
+TickResult tick(const RtModel& model, RtData& data, TickIo& io, const TickTiming& timing) noexcept {
+  const RtConfig& config = model.config;
+  const TimeNs now_ns = timing.now_ns;
+  std::uint32_t flags = 0;
+
+  // 1. read device … velocity
+  const std::uint32_t sample_faults = read_device(model, data, io.device, now_ns);
+  data.have_position = sample_faults == 0;
+  if (data.have_position) observe_energy(data.passivity, data.p_device_m);
+  update_device_faults(model, data, sample_faults);
+
+  // 2. latest proxy: wait-free fetch + validate (runs during device faults too, so the
+  //    proxy age and the reject counters stay right)
+  const ProxyIntake intake = take_latest_proxy(io.proxy_in, data.proxy, now_ns);
+  const TimeNs proxy_age = proxy_age_ns(data.proxy, now_ns);
+  const bool usable = proxy_usable(config.proxy, data.proxy.have_proxy, data.proxy.invalid_latched, proxy_age);
+  if (data.proxy.invalid_latched) flags |= kFaultProxyInvalid;
+  if (data.proxy.have_proxy && to_seconds(proxy_age) > config.proxy.stale_after_s) flags |= kFaultProxyStale;
+
+  // 3. Hunt-Crossley at the current position → blend on swap → staleness fade → passivity
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+  const double fade_gain = update_fade(config.proxy, data.fade, usable, model.period_s);
+  if (data.have_position) {
+    data.tool = device_to_tool(config.mapping, data.p_device_m, data.v_device_m_per_s);
+    Eigen::Vector3d new_force = Eigen::Vector3d::Zero();
+    data.max_penetration_m = -1.0;
+    data.patches_in_contact = 0;
+    if (data.proxy.have_proxy) {
+      const ContactEvaluation evaluation =
+          evaluate_proxy(active_proxy(data.proxy), config.mapping, data.tool, data.part_forces);
+      data.max_penetration_m = evaluation.max_penetration_m;
+      data.patches_in_contact = evaluation.patches_in_contact;
+      new_force = part_forces_to_device(config.mapping, data.part_forces);
+    }
+    if (intake == ProxyIntake::kAccepted) {
+      Eigen::Vector3d old_force = Eigen::Vector3d::Zero();  // the first proxy blends in from zero
+      if (data.proxy.have_previous) {
+        evaluate_proxy(previous_proxy(data.proxy), config.mapping, data.tool, data.part_forces);
+        old_force = part_forces_to_device(config.mapping, data.part_forces);
+      }
+      begin_swap(data.blend, old_force, new_force);
+    }
+    data.contact_force_device_n = fade_gain * blend(data.blend, new_force, config.proxy.blend_max_step_n);
+    force = passivity_control(config.passivity, data.passivity, data.contact_force_device_n, data.v_device_m_per_s,
+                              data.velocity.x1, model.period_s);
+    if ((data.passivity.damping_n_s_per_m) > 0.0) flags |= kFlagPassivityActive;
+  } else {
+    data.contact_force_device_n.setZero();
+  }
+
+  // 4. safety (the last line), then Jᵀ → motor command for the next exchange
+  SafetyInput safety_input;
+  safety_input.force_device_n = force;
+  safety_input.p_device_m = data.p_device_m;
+  safety_input.device_fault = data.faults.latched_device_faults != 0;
+  safety_input.stop_requested = timing.stop_requested;
+  data.force_device_n = apply_safety(config.safety, data.safety, safety_input, model.period_s, flags);
+  if (!force_to_command(config.kinematics.geometry, config.kinematics.newton_metre_per_count, data.p_device_m,
+                        data.force_device_n, data.pending_command, flags)) {
+    data.force_device_n.setZero();
+  }
+  if ((flags & kFaultNonFinite) != 0u && (sample_faults & kFaultNonFinite) == 0u) {
+    // Non-finite force or a Jacobian failure found late: same treatment as a bad sample.
+    ++data.faults.non_finite;
+    update_device_faults(model, data, kFaultNonFinite);
+  }
+  record_sent_force(data.passivity, data.force_device_n);
+  flags |= data.faults.latched_device_faults | sample_faults;
+  if ((flags & kDeviceSideFaults) != 0u) ++data.faults.fault_ticks;
+
+  // 5. DeviceState to the host, telemetry to the logger
+  DeviceState state;
+  state.sequence = ++data.device_state_sequence;
+  state.sample_time_ns = now_ns;
+  state.position_device_m = to_vec3(data.kinematics.p_device_m);
+  state.velocity_device_m_per_s = to_vec3(data.v_device_m_per_s);
+  state.closing_axis_m = jaw_closing_m(config.mapping, data.kinematics.p_device_m);
+  state.buttons = data.reading.buttons;
+  state.status_flags = to_device_status(data, flags);
+  io.state_out.publish(state);
+
+  TelemetrySample sample;
+  sample.tick = data.tick_index;
+  sample.time_ns = now_ns;
+  sample.wakeup_latency_ns = timing.wakeup_latency_ns;
+  sample.overruns = timing.overruns;
+  sample.position_device_m = state.position_device_m;
+  sample.velocity_device_m_per_s = state.velocity_device_m_per_s;
+  sample.tool_position_world_m = to_vec3(data.tool.p_tool_world_m);
+  sample.contact_force_device_n = to_vec3(data.contact_force_device_n);
+  sample.force_device_n = to_vec3(data.force_device_n);
+  sample.motor_counts = data.pending_command.motor_counts;
+  sample.patches_in_contact = static_cast<std::uint16_t>(data.patches_in_contact);
+  sample.jaw_closing_m = state.closing_axis_m;
+  sample.max_penetration_m = data.max_penetration_m;
+  sample.energy_j = data.passivity.energy_j;
+  sample.passivity_damping_n_s_per_m = data.passivity.damping_n_s_per_m;
+  sample.fade_gain = fade_gain;
+  sample.ramp_gain = data.safety.ramp_gain;
+  sample.proxy_age_ns = proxy_age;
+  sample.proxy_sequence = data.proxy.have_proxy ? active_proxy(data.proxy).sequence : 0;
+  sample.proxies_rejected = data.proxy.rejected_count;
+  sample.fault_bits = flags;
+  sample.buttons = data.reading.buttons;
+  sample.io_status = static_cast<std::uint8_t>(data.io_status);
+  sample.fk_iterations = static_cast<std::int8_t>(std::min(data.kinematics.last.iterations, 127));
+  if (!io.telemetry.try_push(sample)) ++data.telemetry_dropped;
+
+  ++data.tick_index;
+  TickResult result;
+  result.fault_bits = flags;
+  result.force_device_n = data.force_device_n;
+  result.stopped = data.safety.phase == RampPhase::kStopped;
+  return result;
+}
+
+}  // namespace fissure::rt

@@ -1,0 +1,312 @@
+// The tick as a whole, against a device that holds still (exact, deterministic numbers).
+// Loop-level behaviour against SimFalcon (energy, allocations, overruns) is in rt_loop_test.
+#include "fissure/rt_core/tick.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "fissure/rt_core/faults.hpp"
+#include "rt_test_support.hpp"
+
+namespace fissure::rt {
+namespace {
+
+using testing::plane_proxy;
+using testing::StillDevice;
+
+const Eigen::Vector3d kCentre_device_m(0.0, 0.0, 0.125);
+constexpr double kStiffness_n_per_m = 500.0;
+constexpr double kPlaneY_m = 0.005;  // 5 mm above the centre: 2.5 N at 500 N/m
+
+struct Harness {
+  explicit Harness(const RtConfig& config = RtConfig{}, const Eigen::Vector3d& p = kCentre_device_m) : device(p) {
+    if (!build_model(config, model)) throw std::runtime_error("bad config");
+    reset_data(model, data);
+  }
+  TickResult step(bool stop = false) {
+    now_ns += model.period_ns;
+    TickTiming timing;
+    timing.now_ns = now_ns;
+    timing.stop_requested = stop;
+    TickIo io{device, proxy_in, state_out, *telemetry};
+    const TickResult result = tick(model, data, io, timing);
+    while (telemetry->try_pop(last_sample)) {
+    }
+    return result;
+  }
+  void publish(double k, double plane_y = kPlaneY_m) {
+    proxy_in.publish(plane_proxy(++sequence, {0.0, plane_y, 0.0}, {0.0, 1.0, 0.0}, k));
+  }
+  // Proxy published every tick (a 1 kHz host) until ramp-in, fade-in and blend are done.
+  void settle(double k = kStiffness_n_per_m) {
+    for (int i = 0; i < 700; ++i) {
+      publish(k);
+      step();
+    }
+  }
+  [[nodiscard]] double expected_force_y(double k = kStiffness_n_per_m) const {
+    return k * (kPlaneY_m - data.p_device_m.y());
+  }
+
+  RtModel model;
+  RtData data;
+  StillDevice device;
+  ProxyExchange proxy_in;
+  DeviceStateExchange state_out;
+  std::unique_ptr<TelemetryRing> telemetry = std::make_unique<TelemetryRing>();
+  TelemetrySample last_sample{};
+  TimeNs now_ns = 0;
+  std::uint64_t sequence = 0;
+};
+
+TEST(Tick, RendersHuntCrossleyAtTheCurrentPositionAfterTheRampIn) {
+  Harness h;
+  h.settle();
+  const TickResult result = h.step();
+  EXPECT_EQ(result.fault_bits & kAnyFault, 0u);
+  EXPECT_NEAR(h.data.p_device_m.x(), 0.0, 1e-4);  // FK of the quantised encoders
+  EXPECT_NEAR(result.force_device_n.y(), h.expected_force_y(), 1e-9);
+  EXPECT_NEAR(result.force_device_n.x(), 0.0, 1e-12);
+  EXPECT_EQ(h.last_sample.patches_in_contact, 1);
+  EXPECT_NEAR(h.last_sample.max_penetration_m, kPlaneY_m - h.data.p_device_m.y(), 1e-15);
+}
+
+TEST(Tick, CommandGoesOutWithTheNextExchange) {
+  Harness h;
+  h.settle();
+  h.step();
+  const auto computed = h.data.pending_command.motor_counts;
+  EXPECT_NE(computed, (std::array<std::int16_t, 3>{0, 0, 0}));
+  h.step();
+  EXPECT_EQ(h.device.last_command.motor_counts, computed);
+}
+
+TEST(Tick, PublishesDeviceStateForTheHost) {
+  Harness h;
+  h.step();
+  h.step();
+  DeviceState state;
+  ASSERT_TRUE(h.state_out.try_fetch(state));
+  EXPECT_EQ(state.sequence, 2u);
+  EXPECT_EQ(state.sample_time_ns, 2 * h.model.period_ns);
+  EXPECT_NEAR(state.position_device_m[2], 0.125, 1e-4);
+  EXPECT_NE(state.status_flags & kDeviceHomed, 0u);
+  EXPECT_EQ(state.status_flags & fissure::kDeviceFaultMask, 0u);
+}
+
+TEST(Tick, ProxySwapChangesTheForceByAtMostTheBlendBoundPerTick) {
+  Harness h;
+  h.settle();
+  double previous = h.step().force_device_n.y();
+  const double bound = h.model.config.proxy.blend_max_step_n;
+  double max_step = 0.0;
+  for (int i = 0; i < 300; ++i) {
+    h.publish(3.0 * kStiffness_n_per_m);  // 2.5 N → 7.5 N from one host step to the next
+    const double y = h.step().force_device_n.y();
+    max_step = std::max(max_step, std::fabs(y - previous));
+    previous = y;
+  }
+  EXPECT_LE(max_step, bound + 1e-12);
+  EXPECT_GT(max_step, 0.9 * bound);  // it did blend, at the bound
+  EXPECT_NEAR(previous, h.expected_force_y(3.0 * kStiffness_n_per_m), 1e-9);
+}
+
+TEST(Tick, StaleProxyFadesToZeroWithinItsBoundAndRecovers) {
+  Harness h;
+  h.settle();
+  const ProxyConfig& proxy = h.model.config.proxy;
+  const double full = h.expected_force_y();
+  // The host dies: the last proxy was accepted in the last settle() tick.
+  const TimeNs accepted_ns = h.now_ns;
+  const auto stale_ticks = static_cast<int>(std::llround(proxy.stale_after_s / h.model.period_s));
+  const auto bound_ticks = static_cast<int>(std::llround((proxy.stale_after_s + proxy.fade_s) / h.model.period_s)) + 1;
+  for (int i = 1; i <= bound_ticks; ++i) {
+    const TickResult result = h.step();
+    const double age_s = to_seconds(h.now_ns - accepted_ns);
+    if (i <= stale_ticks) {
+      EXPECT_NEAR(result.force_device_n.y(), full, 1e-9) << "age " << age_s;
+      EXPECT_EQ(result.fault_bits & kFaultProxyStale, 0u);
+    } else {
+      EXPECT_NE(result.fault_bits & kFaultProxyStale, 0u);
+    }
+  }
+  EXPECT_EQ(h.data.force_device_n, Eigen::Vector3d::Zero()) << "not zero at stale_after_s + fade_s + 1 tick";
+  EXPECT_EQ(h.data.pending_command.motor_counts, (std::array<std::int16_t, 3>{0, 0, 0}));
+  // Recovery: the host comes back; the force fades back in without a step.
+  double previous = 0.0;
+  double max_step = 0.0;
+  for (int i = 0; i < 200; ++i) {
+    h.publish(kStiffness_n_per_m);
+    const TickResult result = h.step();
+    EXPECT_EQ(result.fault_bits & kFaultProxyStale, 0u);
+    max_step = std::max(max_step, std::fabs(result.force_device_n.y() - previous));
+    previous = result.force_device_n.y();
+  }
+  EXPECT_NEAR(previous, full, 1e-9);
+  EXPECT_LE(max_step, full * h.model.period_s / proxy.fade_s + 1e-9);
+}
+
+TEST(Tick, InvalidProxyIsRejectedCountedAndFadesTheForceOut) {
+  Harness h;
+  h.settle();
+  ContactProxy bad = plane_proxy(++h.sequence, {0.0, kPlaneY_m, 0.0}, {0.0, 1.0, 0.0}, kStiffness_n_per_m);
+  bad.patches[0].normal_world = {0.0, std::numeric_limits<double>::infinity(), 0.0};
+  h.proxy_in.publish(bad);
+  const auto fade_ticks = static_cast<int>(std::llround(h.model.config.proxy.fade_s / h.model.period_s)) + 1;
+  for (int i = 0; i < fade_ticks; ++i) EXPECT_NE(h.step().fault_bits & kFaultProxyInvalid, 0u);
+  EXPECT_EQ(h.data.force_device_n, Eigen::Vector3d::Zero());
+  EXPECT_EQ(h.data.proxy.rejected_count, 1u);
+  EXPECT_EQ(h.last_sample.proxies_rejected, 1u);
+  // Recovery: the next valid proxy clears the fault and the force comes back.
+  for (int i = 0; i < 200; ++i) {
+    h.publish(kStiffness_n_per_m);
+    EXPECT_EQ(h.step().fault_bits & kFaultProxyInvalid, 0u);
+  }
+  EXPECT_NEAR(h.data.force_device_n.y(), h.expected_force_y(), 1e-9);
+}
+
+// A device fault: zero command at once and while it lasts, zero for recovery_ticks after,
+// then the force ramps back in (fault_ramp_in_s) — never a step.
+void expect_device_fault_recovery(Harness& h, std::uint32_t fault_bit) {
+  const FaultConfig& faults = h.model.config.faults;
+  for (int i = 1; i < faults.recovery_ticks; ++i) {
+    h.publish(kStiffness_n_per_m);
+    const TickResult result = h.step();
+    EXPECT_EQ(result.force_device_n, Eigen::Vector3d::Zero()) << "recovery tick " << i;
+    EXPECT_NE(result.fault_bits & fault_bit, 0u);
+  }
+  double previous = 0.0;
+  double max_step = 0.0;
+  for (int i = 0; i < 400; ++i) {
+    h.publish(kStiffness_n_per_m);
+    const TickResult result = h.step();
+    EXPECT_EQ(result.fault_bits & kDeviceSideFaults, 0u);
+    max_step = std::max(max_step, std::fabs(result.force_device_n.y() - previous));
+    previous = result.force_device_n.y();
+  }
+  const double expected = std::min(h.expected_force_y(), h.model.config.safety.max_force_n);
+  EXPECT_NEAR(previous, expected, 1e-9);
+  EXPECT_LE(max_step, expected * h.model.period_s / h.model.config.safety.fault_ramp_in_s + 1e-9);
+}
+
+TEST(Tick, DeviceTimeoutGivesZeroForceAndRecoversAfterCleanTicks) {
+  Harness h;
+  h.settle();
+  for (const falcon::IoStatus status :
+       {falcon::IoStatus::kTimeout, falcon::IoStatus::kTornPacket, falcon::IoStatus::kNotRunning}) {
+    h.device.status = status;
+    for (int i = 0; i < 5; ++i) {
+      h.publish(kStiffness_n_per_m);
+      const TickResult result = h.step();
+      EXPECT_EQ(result.force_device_n, Eigen::Vector3d::Zero());
+      EXPECT_EQ(h.data.pending_command.motor_counts, (std::array<std::int16_t, 3>{0, 0, 0}));
+      EXPECT_NE(result.fault_bits & kFaultDeviceIo, 0u);
+    }
+    DeviceState state;
+    ASSERT_TRUE(h.state_out.try_fetch(state));
+    EXPECT_NE(state.status_flags & (kDeviceFaultTimeout | kDeviceFaultTornPacket), 0u);
+    h.device.status = falcon::IoStatus::kOk;
+    expect_device_fault_recovery(h, kFaultDeviceIo);
+  }
+  EXPECT_EQ(h.data.faults.io_errors, 15u);
+}
+
+TEST(Tick, DisconnectIsLatchedAtZeroForce) {
+  Harness h;
+  h.settle();
+  h.device.status = falcon::IoStatus::kDisconnected;
+  EXPECT_EQ(h.step().force_device_n, Eigen::Vector3d::Zero());
+  h.device.status = falcon::IoStatus::kOk;  // even if replies came back, nothing is trusted
+  for (int i = 0; i < 1000; ++i) {
+    h.publish(kStiffness_n_per_m);
+    const TickResult result = h.step();
+    ASSERT_EQ(result.force_device_n, Eigen::Vector3d::Zero());
+    ASSERT_NE(result.fault_bits & kFaultDeviceDisconnected, 0u);
+  }
+  DeviceState state;
+  ASSERT_TRUE(h.state_out.try_fetch(state));
+  EXPECT_NE(state.status_flags & kDeviceFaultDisconnected, 0u);
+}
+
+TEST(Tick, EncoderJumpGivesZeroForceAndRecovers) {
+  Harness h;
+  h.settle();
+  h.device.counts[0] = static_cast<std::int16_t>(h.device.counts[0] + 250);  // > 157 counts per ms
+  h.publish(kStiffness_n_per_m);
+  const TickResult result = h.step();
+  EXPECT_EQ(result.force_device_n, Eigen::Vector3d::Zero());
+  EXPECT_NE(result.fault_bits & kFaultEncoderJump, 0u);
+  EXPECT_EQ(h.data.faults.encoder_jumps, 1u);
+  // The offset persists (lost counts): judged against the jumped value from now on.
+  expect_device_fault_recovery(h, kFaultEncoderJump);
+}
+
+TEST(Tick, KinematicsFailureIsANonFiniteFaultWithZeroForce) {
+  Harness h;
+  h.device.counts = {10000, 10000, 10000};  // arm angles no reachable position has
+  for (int i = 0; i < 50; ++i) {
+    h.publish(kStiffness_n_per_m);
+    const TickResult result = h.step();
+    ASSERT_EQ(result.force_device_n, Eigen::Vector3d::Zero());
+    ASSERT_NE(result.fault_bits & kFaultNonFinite, 0u);
+  }
+  EXPECT_EQ(h.data.faults.non_finite, 50u);
+  // Back to a real position: that is itself an encoder jump; then FK restarts cold and the
+  // faults clear.
+  h.device.place(kCentre_device_m);
+  h.publish(kStiffness_n_per_m);
+  EXPECT_NE(h.step().fault_bits & kFaultEncoderJump, 0u);
+  expect_device_fault_recovery(h, kFaultEncoderJump);
+}
+
+TEST(Tick, StopRampsOutToZero) {
+  Harness h;
+  h.settle();
+  const auto ramp_ticks = static_cast<int>(std::llround(h.model.config.safety.ramp_out_s / h.model.period_s));
+  bool stopped = false;
+  int ticks = 0;
+  while (!stopped && ticks < 1000) {
+    h.publish(kStiffness_n_per_m);
+    stopped = h.step(true).stopped;
+    ++ticks;
+  }
+  EXPECT_NEAR(ticks, ramp_ticks, 1);
+  EXPECT_EQ(h.data.force_device_n, Eigen::Vector3d::Zero());
+}
+
+TEST(Tick, ClampModeRendersTheGripOnTheClosingAxis) {
+  RtConfig config;
+  config.mapping.clamp_mode = true;
+  config.mapping.closing_axis_world = 0;
+  config.mapping.device_origin_m = {0.0, 0.0, 0.125};
+  Harness h(config, kCentre_device_m + Eigen::Vector3d(0.004, 0.0, 0.0));
+  ContactProxy proxy;
+  proxy.flags = kProxyValid;
+  proxy.patch_count = 2;
+  for (int i = 0; i < 2; ++i) {
+    ContactPatch& patch = proxy.patches[i];
+    const double side = i == 0 ? 1.0 : -1.0;  // jaw A on −x moves to +x when closing
+    patch.tool_part = i == 0 ? ToolPart::kJawA : ToolPart::kJawB;
+    patch.plane_point_world_m = {side * 0.001, 0.0, 0.0};
+    patch.normal_world = {-side, 0.0, 0.0};
+    patch.stiffness_k = 1000.0;
+  }
+  TickResult result;
+  for (int i = 0; i < 700; ++i) {
+    proxy.sequence = i + 1;
+    h.proxy_in.publish(proxy);
+    result = h.step();
+  }
+  const double closing = h.data.p_device_m.x();
+  const double penetration = closing / 2.0 - 0.001;  // each jaw, ≈ 1 mm
+  EXPECT_NEAR(h.last_sample.jaw_closing_m, closing, 1e-15);
+  EXPECT_NEAR(result.force_device_n.x(), -1000.0 * penetration, 1e-9);  // grip resists the closing
+  EXPECT_NEAR(result.force_device_n.y(), 0.0, 1e-12);
+  EXPECT_NEAR(result.force_device_n.z(), 0.0, 1e-12);
+}
+
+}  // namespace
+}  // namespace fissure::rt
