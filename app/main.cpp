@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "device_usb.hpp"
 
 namespace {
 
@@ -42,7 +43,8 @@ int main(int argc, char** argv) {
   auto* device = root.add_subcommand("device", "Novint Falcon: kinematics, probe, firmware, homing");
   device->require_subcommand(1);
   fissure::app::CommandTree tree{root, *bench, *device};
-  (void)tree;  // each module's register_*(tree) goes here as it lands
+  // each module's register_*(tree) goes here as it lands
+  fissure::app::register_device_usb(tree);
 
   if (const std::string unknown = unknown_subcommand(root, argc, argv); !unknown.empty()) {
     std::fprintf(stderr, "fissure: error: %s (see 'fissure --help')\n", unknown.c_str());
