@@ -44,12 +44,15 @@ HandshakeEvent Handshake::on_hello(const Hello& peer) noexcept {
     peer_acknowledged_ = false;
     return event;
   }
+  const bool newly_established = state_ != HandshakeState::kEstablished || event.peer_restarted;
   state_ = HandshakeState::kEstablished;
   error_ = HandshakeError::kNone;
   error_message_[0] = '\0';
   peer_acknowledged_ = (peer.flags & kHelloPeerSeen) != 0;
   event.established = true;
-  event.reply_needed = !peer_acknowledged_;
+  // Reply when the peer has not seen us, and once on establishing: our earlier Hellos (if
+  // any) went out without kHelloPeerSeen, and the peer keeps repeating until it gets one with it.
+  event.reply_needed = !peer_acknowledged_ || newly_established;
   return event;
 }
 

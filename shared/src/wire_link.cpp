@@ -78,6 +78,8 @@ bool LinkSender::idle() const noexcept {
 
 LinkPollResult LinkReceiver::poll() noexcept {
   LinkPollResult result;
+  // Time out lost segments even when nothing arrives (a dead link still ages its assemblies).
+  reassembler_.expire(clock_.now());
   for (std::size_t i = 0; i < config_.max_frames_per_poll; ++i) {
     ReceivedFrame received;
     const CarrierStatus status = carrier_.try_receive(received);

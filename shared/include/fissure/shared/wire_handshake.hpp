@@ -17,7 +17,7 @@ enum class HandshakeError : std::uint8_t { kNone, kVersionMismatch, kRoleConflic
 struct HandshakeEvent {
   bool established = false;     ///< the link is (still) usable after this Hello
   bool peer_restarted = false;  ///< first Hello of this peer session: forget its old sequence numbers
-  bool reply_needed = false;    ///< the peer has not seen our Hello yet: send one now
+  bool reply_needed = false;    ///< send a Hello now: the peer has not seen ours, or we just established
 };
 
 class Handshake {
