@@ -54,6 +54,7 @@ void validate(const SimFalconConfig& config) {
   require_positive(dynamics.physics_rate_hz, "dynamics.physics_rate_hz");
   if (dynamics.physics_rate_hz > 1e8) reject("dynamics.physics_rate_hz", "<= 1e8 (10 ns sub-steps)", dynamics.physics_rate_hz);
   require_positive(dynamics.max_catch_up_s, "dynamics.max_catch_up_s");
+  if (dynamics.max_catch_up_s > 10.0) reject("dynamics.max_catch_up_s", "<= 10 s (one call must stay bounded)", dynamics.max_catch_up_s);
   require_finite(dynamics.end_stop_centre_device_m, "dynamics.end_stop_centre_device_m");
   require_positive(dynamics.end_stop_radius_m, "dynamics.end_stop_radius_m");
   require_non_negative(dynamics.end_stop_stiffness_n_per_m, "dynamics.end_stop_stiffness_n_per_m");

@@ -355,6 +355,24 @@ TEST(SimFalcon, LongStallsAreSkippedNotIntegrated) {
   EXPECT_EQ(sim.truth().time_ns, from_seconds(1.0));
 }
 
+TEST(SimFalcon, RunsOnTheRealClockToo) {
+  // No timing assertions (tests must not depend on machine speed): only that physics time
+  // follows the clock it is given and the replies are stamped with it.
+  MonotonicClock clock;
+  SimFalconConfig config;
+  config.initial_velocity_device_m_per_s = {0.01, 0.0, 0.0};
+  SimFalcon sim(config, clock);
+  DeviceReading reading;
+  TimeNs previous_ns = sim.session_start_ns();
+  for (int k = 0; k < 50; ++k) {
+    ASSERT_EQ(sim.try_exchange(DeviceCommand{}, reading), IoStatus::kOk);
+    EXPECT_EQ(sim.truth().time_ns, reading.receive_time_ns);
+    EXPECT_GE(reading.receive_time_ns, previous_ns);
+    previous_ns = reading.receive_time_ns;
+  }
+  EXPECT_GT(sim.truth().position_device_m.x(), 0.0);
+}
+
 // ---- Fault injection ------------------------------------------------------------------
 
 struct ExchangeLog {

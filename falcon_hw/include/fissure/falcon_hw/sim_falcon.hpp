@@ -148,7 +148,8 @@ struct SimFalconConfig {
   /// The scripted hand holding the grip; none ⇒ nobody touches the grip.
   std::optional<HandScript> hand;
   /// Reported homed flags (bit i: arm i). SimFalcon starts in the running state; the homing
-  /// bit and the LEDs in the command are accepted and ignored.
+  /// bit and the LEDs in the command are accepted and ignored. Buttons come from the hand's
+  /// button script, masked to the Falcon's four (low nibble); 0 without a hand.
   std::uint8_t homed_mask = 0x7;
   SimFaultConfig faults{};
 };
@@ -186,6 +187,8 @@ class SimFalcon final : public HapticDevice {
   [[nodiscard]] const char* name() const noexcept override { return "sim-falcon"; }
   IoStatus try_exchange(const DeviceCommand& command, DeviceReading& reading) noexcept override;
 
+  /// Ground truth and counters are plain data, not synchronised: read them on the thread
+  /// that calls try_exchange(), or after it has stopped.
   [[nodiscard]] const SimFalconTruth& truth() const noexcept { return truth_; }
   [[nodiscard]] const SimFalconCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] const SimFalconConfig& config() const noexcept { return config_; }
