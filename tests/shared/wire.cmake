@@ -10,3 +10,4 @@ fissure_add_test(shared_udp_carrier_test SOURCES udp_carrier_test.cpp LIBS fissu
 fissure_add_test(shared_socketcan_carrier_test SOURCES socketcan_carrier_test.cpp LIBS fissure_shared)
 fissure_add_test(shared_fault_injection_test SOURCES fault_injection_test.cpp LIBS fissure_shared)
 fissure_add_test(shared_wire_allocation_test SOURCES wire_allocation_test.cpp LIBS fissure_shared)
+fissure_add_test(shared_transport_spec_test SOURCES transport_spec_test.cpp LIBS fissure_shared)
