@@ -2,6 +2,7 @@
 // Invariants: no crash / out-of-bounds (ASan), the counters account for every byte, and the
 // packets found are exactly the valid 16-byte windows of the input (markers cannot be
 // payload, so valid windows never overlap and each must be recovered).
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>

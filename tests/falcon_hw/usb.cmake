@@ -19,9 +19,12 @@ endif()
 #   cmake --build build-fuzz --target falcon_stream_parser_fuzzer && build-fuzz/tests/falcon_stream_parser_fuzzer -runs=1000000
 option(FISSURE_FUZZ "Build libFuzzer targets (clang)" OFF)
 if(FISSURE_FUZZ AND CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
-  add_executable(falcon_stream_parser_fuzzer EXCLUDE_FROM_ALL falcon_stream_parser_fuzzer.cpp)
+  # The parser's sources are compiled into the fuzzer so they get its coverage instrumentation.
+  add_executable(falcon_stream_parser_fuzzer EXCLUDE_FROM_ALL falcon_stream_parser_fuzzer.cpp
+    ${PROJECT_SOURCE_DIR}/falcon_hw/src/falcon_stream_parser.cpp ${PROJECT_SOURCE_DIR}/falcon_hw/src/falcon_packet.cpp)
   fissure_target_defaults(falcon_stream_parser_fuzzer)
-  target_link_libraries(falcon_stream_parser_fuzzer PRIVATE fissure_falcon_hw)
+  target_include_directories(falcon_stream_parser_fuzzer PRIVATE ${PROJECT_SOURCE_DIR}/falcon_hw/include)
+  target_link_libraries(falcon_stream_parser_fuzzer PRIVATE fissure_shared)
   target_compile_options(falcon_stream_parser_fuzzer PRIVATE -fsanitize=fuzzer,address,undefined)
   target_link_options(falcon_stream_parser_fuzzer PRIVATE -fsanitize=fuzzer,address,undefined)
   set_target_properties(falcon_stream_parser_fuzzer PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)

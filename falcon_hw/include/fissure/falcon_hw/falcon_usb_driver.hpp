@@ -112,6 +112,9 @@ class FalconUsbDriver final : public HapticDevice {
 
   // HapticDevice
   [[nodiscard]] const char* name() const noexcept override { return "usb-falcon"; }
+  /// One ping-pong, bounded by reply_timeout_ns (+ write_timeout_ns). On any status but
+  /// kOk `reading` is left untouched. kDisconnected is sticky (state kFault); so is kFault
+  /// after fault_after_failed_exchanges consecutive failures (then kNotRunning).
   IoStatus try_exchange(const DeviceCommand& command, DeviceReading& reading) noexcept override;
 
   [[nodiscard]] DriverState state() const noexcept { return state_; }
