@@ -107,7 +107,8 @@ class FalconUsbDriver final : public HapticDevice {
   /// In kOpened with firmware: kRunning without homing (encoders are then relative to
   /// power-up; fine for probing, not for haptics).
   bool start_running() noexcept;
-  /// Any state → kClosed; releases the transport.
+  /// Any state → kClosed; closes the transport too, so reconnecting (after an unplug, say)
+  /// means a new transport and driver — the CLI opens one per command.
   void close() noexcept;
 
   // HapticDevice
