@@ -86,6 +86,27 @@ TEST(InverseKinematics, AxisPointsGiveEqualAnglesAndTheCentreMatchesTheEncoderRa
   EXPECT_NEAR(theta[0], 35.0 * std::numbers::pi / 180.0, 20.0 * std::numbers::pi / 180.0);
 }
 
+TEST(InverseKinematics, OtherArmAnglesAreHonoured) {
+  // The stock φ uses precomputed sines; an equivalent φ (+2π) takes the general path and
+  // must agree, and a genuinely different φ must change the answer.
+  FalconGeometry wrapped;
+  for (double& phi : wrapped.phi_rad) phi += 2.0 * std::numbers::pi;
+  FalconGeometry rotated;
+  rotated.phi_rad[0] += 0.1;
+  for (const Eigen::Vector3d& p : sample_workspace(200, 23)) {
+    Eigen::Vector3d theta_stock;
+    Eigen::Vector3d theta_wrapped;
+    Eigen::Vector3d theta_rotated;
+    ASSERT_TRUE(inverse_kinematics(kGeometry, p, theta_stock));
+    ASSERT_TRUE(inverse_kinematics(wrapped, p, theta_wrapped));
+    EXPECT_LT((theta_stock - theta_wrapped).cwiseAbs().maxCoeff(), 1e-12);
+    if (inverse_kinematics(rotated, p, theta_rotated)) {
+      EXPECT_GT(std::abs(theta_rotated[0] - theta_stock[0]), 1e-6);
+      EXPECT_EQ(theta_rotated[1], theta_stock[1]);
+    }
+  }
+}
+
 TEST(Workspace, WholeBallIsReachableWithConditioningMargins) {
   auto points = sample_workspace(20000, 12);
   const auto surface = sample_workspace_surface(20000, 13, 1.0 - 1e-9);
