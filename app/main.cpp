@@ -5,7 +5,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include "bench_kinematics.hpp"
 #include "commands.hpp"
+#include "device_kinematics.hpp"
 #include "device_usb.hpp"
 
 namespace {
@@ -45,6 +47,8 @@ int main(int argc, char** argv) {
   fissure::app::CommandTree tree{root, *bench, *device};
   // each module's register_*(tree) goes here as it lands
   fissure::app::register_device_usb(tree);
+  fissure::app::register_device_kinematics(tree);
+  fissure::app::register_bench_kinematics(tree);
 
   if (const std::string unknown = unknown_subcommand(root, argc, argv); !unknown.empty()) {
     std::fprintf(stderr, "fissure: error: %s (see 'fissure --help')\n", unknown.c_str());
