@@ -38,10 +38,14 @@ struct ThinBodyCollisionParams {
   HuntCrossleyParams hunt_crossley;
   // Gap left between a displaced soft node and the tool face (keeps nodes strictly outside the
   // tool in float precision; Bullet's soft body here is single precision).
-  double skin_m = 2.0e-5;
+  double skin_m = 1.0e-6;
   // A tool node within this distance in front of a soft triangle counts as touching it (keeps a
   // resting contact from flickering at slow speeds).
-  double contact_distance_m = 5.0e-5;
+  double contact_distance_m = 1.0e-5;
+  // A soft node held on the tool stays a colliding node (its triangles keep their force) until it
+  // separates from the tool face by more than this: hysteresis against contact-set chatter when
+  // the soft body's own dynamics lift a held node by a hair.
+  double release_distance_m = 2.0e-4;
   // ẋ is a finite difference of x filtered by a first-order low-pass with this cut-off
   // (time constant 1/(2π·fc), i.e. ≈1.6 ms lag at 100 Hz).
   double velocity_filter_cutoff_hz = 100.0;

@@ -133,7 +133,7 @@ struct RoundedSpatulaParams {
   double thickness_m = 0.002;    // along y (the thin axis)
   double corner_radius_m = 0.008;
   int corner_segments = 6;       // per 90° of each rounded corner
-  int rim_segments = 6;          // half-circle profile of the rim (≥ 2)
+  int rim_segments = 7;          // half-circle profile of the rim (≥ 2); odd → a band with horizontal normals (Fig. 2)
   int face_divisions = 8;        // grid subdivision of the flat faces (node density)
 };
 ConvexMeshToolShape make_rounded_spatula_mesh(const RoundedSpatulaParams& params, double pairing_ray_limit_m);

@@ -1,0 +1,159 @@
+// Load-time part of the thin-body collision: soft-surface topology and rest state, tool-node bins,
+// and the preallocation of every per-step buffer (the step itself never allocates).
+#include "collision_state.hpp"
+
+#include <BulletSoftBody/btSoftBody.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace fissure::host::thin_body {
+namespace {
+
+Eigen::Vector3d to_eigen(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
+
+ToolNodeBins build_bins(const ToolNodes& tool) {
+  ToolNodeBins bins;
+  const int w = tool.thin_axis();
+  bins.axis_u = w == 0 ? 1 : 0;
+  bins.axis_v = w == 2 ? 1 : 2;
+  const auto& positions = tool.positions_tool_m();
+  const int count = tool.node_count();
+  const Eigen::AlignedBox3d& bounds = tool.bounds_tool_m();
+  const double extent_u = std::max(bounds.sizes()[bins.axis_u], 1e-9);
+  const double extent_v = std::max(bounds.sizes()[bins.axis_v], 1e-9);
+  // About one node per face per cell: cell size from the node density over the footprint.
+  const double per_face = std::max(1.0, 0.5 * count);
+  bins.cell_m = std::max(std::sqrt(extent_u * extent_v / per_face), 1e-6);
+  bins.cells_u = std::clamp(static_cast<int>(std::ceil(extent_u / bins.cell_m)) + 1, 1, 256);
+  bins.cells_v = std::clamp(static_cast<int>(std::ceil(extent_v / bins.cell_m)) + 1, 1, 256);
+  bins.origin_u = bounds.min()[bins.axis_u] - 0.5 * bins.cell_m;
+  bins.origin_v = bounds.min()[bins.axis_v] - 0.5 * bins.cell_m;
+  const auto cell_of = [&](const Eigen::Vector3d& p) {
+    const int cu = std::clamp(static_cast<int>((p[bins.axis_u] - bins.origin_u) / bins.cell_m), 0, bins.cells_u - 1);
+    const int cv = std::clamp(static_cast<int>((p[bins.axis_v] - bins.origin_v) / bins.cell_m), 0, bins.cells_v - 1);
+    return cu * bins.cells_v + cv;
+  };
+  const std::size_t cells = static_cast<std::size_t>(bins.cells_u * bins.cells_v);
+  bins.begin.assign(cells + 1, 0);
+  for (const auto& p : positions) ++bins.begin[static_cast<std::size_t>(cell_of(p) + 1)];
+  for (std::size_t c = 0; c < cells; ++c) bins.begin[c + 1] += bins.begin[c];
+  bins.nodes.assign(static_cast<std::size_t>(count), -1);
+  std::vector<int> fill(bins.begin.begin(), bins.begin.end() - 1);
+  for (int i = 0; i < count; ++i)
+    bins.nodes[static_cast<std::size_t>(fill[static_cast<std::size_t>(cell_of(positions[static_cast<std::size_t>(i)]))]++)] = i;
+  return bins;
+}
+
+}  // namespace
+
+void take_rest_state(const btSoftBody& soft, SoftSurfaceModel& model) {
+  model.rest_centroid_world_m.resize(static_cast<std::size_t>(model.face_count));
+  model.rest_area_m2.resize(static_cast<std::size_t>(model.face_count));
+  double volume6 = 0.0;
+  double area_sum = 0.0;
+  model.max_rest_edge_m = 0.0;
+  Eigen::Vector3d reference = to_eigen(soft.m_nodes[0].m_x);
+  for (int f = 0; f < model.face_count; ++f) {
+    const auto& nodes = model.face_nodes[static_cast<std::size_t>(f)];
+    const Eigen::Vector3d a = to_eigen(soft.m_nodes[nodes[0]].m_x);
+    const Eigen::Vector3d b = to_eigen(soft.m_nodes[nodes[1]].m_x);
+    const Eigen::Vector3d c = to_eigen(soft.m_nodes[nodes[2]].m_x);
+    model.rest_centroid_world_m[static_cast<std::size_t>(f)] = (a + b + c) / 3.0;
+    const double area = 0.5 * (b - a).cross(c - a).norm();
+    model.rest_area_m2[static_cast<std::size_t>(f)] = area;
+    area_sum += area;
+    volume6 += (a - reference).dot((b - reference).cross(c - reference));
+    model.max_rest_edge_m = std::max({model.max_rest_edge_m, (b - a).norm(), (c - b).norm(), (a - c).norm()});
+  }
+  // A closed surface has a volume comparable to area^(3/2); an open sheet has ~0 and keeps
+  // Bullet's winding as its outward side.
+  const double closed_threshold = 1e-3 * std::pow(area_sum, 1.5);
+  model.outward_sign = (std::abs(volume6) / 6.0 > closed_threshold && volume6 < 0.0) ? -1.0 : 1.0;
+}
+
+CollisionModel build_collision_model(const ToolNodes& tool, const btSoftBody& soft,
+                                     const ThinBodyCollisionParams& params, bool paired) {
+  if (soft.m_faces.size() == 0 || soft.m_nodes.size() == 0)
+    throw std::invalid_argument("thin-body collision: the soft body has no triangle faces");
+  if (!(params.skin_m > 0.0) || !(params.contact_distance_m >= params.skin_m))
+    throw std::invalid_argument("thin-body collision: need skin_m > 0 and contact_distance_m >= skin_m");
+  if (!(params.release_distance_m >= 0.0))
+    throw std::invalid_argument("thin-body collision: release_distance_m must be >= 0");
+  if (!(params.velocity_filter_cutoff_hz > 0.0) || !(params.broad_phase_margin_m >= 0.0))
+    throw std::invalid_argument("thin-body collision: velocity_filter_cutoff_hz > 0 and broad_phase_margin_m >= 0");
+  const auto& hc = params.hunt_crossley;
+  if (!(hc.k >= 0.0) || !(hc.lambda >= 0.0) || !(hc.n > 0.0) || !std::isfinite(hc.k) || !std::isfinite(hc.lambda) ||
+      !std::isfinite(hc.n))
+    throw std::invalid_argument("thin-body collision: Hunt-Crossley k, lambda >= 0 and n > 0 (finite)");
+  CollisionModel model{tool, build_bins(tool), SoftSurfaceModel{}, params, paired, 0.0};
+  SoftSurfaceModel& surface = model.soft;
+  surface.node_count = soft.m_nodes.size();
+  surface.face_count = soft.m_faces.size();
+  const btSoftBody::Node* first = &soft.m_nodes[0];
+  surface.face_nodes.resize(static_cast<std::size_t>(surface.face_count));
+  surface.faces_of_node_begin.assign(static_cast<std::size_t>(surface.node_count + 1), 0);
+  for (int f = 0; f < surface.face_count; ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const int index = static_cast<int>(soft.m_faces[f].m_n[k] - first);
+      surface.face_nodes[static_cast<std::size_t>(f)][static_cast<std::size_t>(k)] = index;
+      ++surface.faces_of_node_begin[static_cast<std::size_t>(index + 1)];
+    }
+  }
+  for (int i = 0; i < surface.node_count; ++i)
+    surface.faces_of_node_begin[static_cast<std::size_t>(i + 1)] += surface.faces_of_node_begin[static_cast<std::size_t>(i)];
+  surface.faces_of_node.assign(static_cast<std::size_t>(surface.faces_of_node_begin.back()), -1);
+  std::vector<int> fill(surface.faces_of_node_begin.begin(), surface.faces_of_node_begin.end() - 1);
+  for (int f = 0; f < surface.face_count; ++f)
+    for (const int index : surface.face_nodes[static_cast<std::size_t>(f)])
+      surface.faces_of_node[static_cast<std::size_t>(fill[static_cast<std::size_t>(index)]++)] = f;
+  take_rest_state(soft, surface);
+  // A node already in contact may start a step this far behind its triangle (the soft solver
+  // pushing a held node back a little) and still be in contact; further behind is another surface.
+  model.memory_depth_m = std::max(tool.thickness_m(), 10.0 * params.contact_distance_m);
+  return model;
+}
+
+void allocate_collision_data(const CollisionModel& model, CollisionData& data) {
+  const auto tool_nodes = static_cast<std::size_t>(model.tool.node_count());
+  const auto soft_nodes = static_cast<std::size_t>(model.soft.node_count);
+  const auto soft_faces = static_cast<std::size_t>(model.soft.face_count);
+  data.step = 0;
+  data.node_face.assign(tool_nodes, -1);
+  data.node_face_prev.assign(tool_nodes, -1);
+  data.node_age.assign(tool_nodes, 0);
+  data.node_tau.assign(tool_nodes, 0.0);
+  data.node_facing.assign(tool_nodes, 0.0);
+  data.node_excluded_stamp.assign(tool_nodes, -1);
+  data.contact_nodes.clear();
+  data.contact_nodes.reserve(tool_nodes);
+  data.exclusion.clear();
+  data.exclusion.reserve(tool_nodes);
+  data.soft_stamp.assign(soft_nodes, -1);
+  data.start_tool_m.assign(soft_nodes, Eigen::Vector3d::Zero());
+  data.end_tool_m.assign(soft_nodes, Eigen::Vector3d::Zero());
+  data.moved_stamp.assign(soft_nodes, -1);
+  data.moved_nodes.clear();
+  data.moved_nodes.reserve(soft_nodes);
+  data.hold_stamp.assign(soft_nodes, -1);
+  data.hold_plane.assign(soft_nodes, -1);
+  data.candidate_nodes.clear();
+  data.candidate_nodes.reserve(soft_nodes);
+  data.tree_stack.clear();
+  data.tree_stack.reserve(2 * soft_nodes + 64);  // a binary tree of N leaves has 2N-1 nodes
+  data.face_candidate_stamp.assign(soft_faces, -1);
+  data.candidate_faces.clear();
+  data.candidate_faces.reserve(soft_faces);
+  data.face_contact_stamp.assign(soft_faces, -1);
+  data.face_force_stamp.assign(soft_faces, -1);
+  data.face_plane.assign(soft_faces, -1);
+  data.face_lead_node.assign(soft_faces, -1);
+  data.contacted_faces.clear();
+  data.contacted_faces.reserve(soft_faces);
+  data.hc_stamp.assign(soft_faces, -1);
+  data.hc_x_prev_m.assign(soft_faces, 0.0);
+  data.hc_rate_filtered_m_s.assign(soft_faces, 0.0);
+}
+
+}  // namespace fissure::host::thin_body

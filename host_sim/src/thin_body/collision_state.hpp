@@ -1,0 +1,128 @@
+#pragma once
+// Internal model (const, built once) and data (mutable, preallocated) of the thin-body collision,
+// and the pipeline stages (one file each) that read the model and update the data — MuJoCo style.
+#include <fissure/host_sim/thin_body_collision.hpp>
+#include <fissure/host_sim/thin_tool.hpp>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+class btSoftBody;
+struct btDbvtNode;
+
+namespace fissure::host::thin_body {
+
+// Topology and rest state of the soft surface (paper: "during the object initialization, the
+// original position of each triangle vertices is stored").
+struct SoftSurfaceModel {
+  int node_count = 0;
+  int face_count = 0;
+  std::vector<std::array<int, 3>> face_nodes;
+  std::vector<int> faces_of_node_begin;  // CSR: faces around each node
+  std::vector<int> faces_of_node;
+  std::vector<Eigen::Vector3d> rest_centroid_world_m;
+  std::vector<double> rest_area_m2;
+  double outward_sign = 1.0;   // multiplies Bullet's winding normal to point out of the soft body
+  double max_rest_edge_m = 0.0;
+};
+
+// Uniform 2-D grid of the tool nodes over the two non-thin axes (tool frame), so a soft triangle
+// only tests the tool nodes under its swept footprint: cost grows with the contact patch.
+struct ToolNodeBins {
+  int axis_u = 0;
+  int axis_v = 2;
+  double origin_u = 0.0;
+  double origin_v = 0.0;
+  double cell_m = 1.0;
+  int cells_u = 1;
+  int cells_v = 1;
+  std::vector<int> begin;  // CSR over cells_u * cells_v cells
+  std::vector<int> nodes;
+};
+
+struct CollisionModel {
+  ToolNodes tool;
+  ToolNodeBins bins;
+  SoftSurfaceModel soft;
+  ThinBodyCollisionParams params;
+  bool paired = true;          // false: the ray-only variant
+  double memory_depth_m = 0.0; // how far behind a triangle a node already in contact may start
+};
+
+// Per-step frame quantities.
+struct StepFrame {
+  std::int64_t step = 0;
+  double dt_s = 0.0;
+  Eigen::Matrix3d r_prev = Eigen::Matrix3d::Identity();  // tool → world at the previous pose
+  Eigen::Vector3d t_prev = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d r_cur = Eigen::Matrix3d::Identity();   // tool → world at the current pose
+  Eigen::Vector3d t_cur = Eigen::Vector3d::Zero();
+  Eigen::Vector3d velocity_world_m_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity_world = Eigen::Vector3d::Zero();
+  Eigen::AlignedBox3d swept_tool_world_m;
+};
+
+struct CollisionData {
+  std::int64_t step = 0;
+  // Tool nodes: contact this step and the side memory from the previous one.
+  std::vector<int> node_face;        // soft face in contact (-1: none)
+  std::vector<int> node_face_prev;
+  std::vector<int> node_age;         // consecutive steps in contact (who led first)
+  std::vector<double> node_tau;      // fraction of the step at which the contact began
+  std::vector<double> node_facing;   // tool normal · soft normal (−1: head on)
+  std::vector<std::int64_t> node_excluded_stamp;
+  std::vector<int> contact_nodes;    // nodes in contact this step (before exclusion)
+  std::vector<int> exclusion;        // the paper's exclusion vector (this step)
+  // Soft nodes near the tool: positions in the tool frame at the start (previous pose, m_q) and
+  // at the end (current pose, m_x) of the step.
+  std::vector<std::int64_t> soft_stamp;
+  std::vector<Eigen::Vector3d> start_tool_m;
+  std::vector<Eigen::Vector3d> end_tool_m;
+  std::vector<std::int64_t> moved_stamp;   // displaced this step ...
+  std::vector<int> moved_nodes;            // ... listed (their triangles have a colliding node)
+  std::vector<std::int64_t> hold_stamp;    // soft-node side memory: held on a tool plane ...
+  std::vector<int> hold_plane;             // ... this one, at step hold_stamp
+  std::vector<int> candidate_nodes;
+  std::vector<const btDbvtNode*> tree_stack;
+  // Soft faces.
+  std::vector<std::int64_t> face_candidate_stamp;
+  std::vector<int> candidate_faces;
+  std::vector<std::int64_t> face_contact_stamp;
+  std::vector<int> face_plane;
+  std::vector<int> face_lead_node;
+  std::vector<int> contacted_faces;       // stage 3: faces hit by a tool node; stage 4: faces with a colliding soft node
+  std::vector<std::int64_t> face_force_stamp;
+  std::vector<std::int64_t> hc_stamp;   // last step the face was in contact (filter state valid)
+  std::vector<double> hc_x_prev_m;
+  std::vector<double> hc_rate_filtered_m_s;
+};
+
+CollisionModel build_collision_model(const ToolNodes& tool, const btSoftBody& soft,
+                                     const ThinBodyCollisionParams& params, bool paired);
+void take_rest_state(const btSoftBody& soft, SoftSurfaceModel& model);
+void allocate_collision_data(const CollisionModel& model, CollisionData& data);
+
+// Stage 1 (broad_phase.cpp): swept tool bounds vs the soft body's node tree; on a hit, collects
+// candidate soft nodes / faces and their tool-frame start / end positions. false = out of contact.
+bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data);
+// Stage 2 (node_sweep.cpp): every tool node against the candidate triangles, swept over the step.
+void sweep_tool_nodes(const CollisionModel& model, CollisionData& data);
+// Stage 3 (pair_exclusion.cpp): infeasible pairs → exclusion vector (paired only); assigns each
+// contacted face the tool plane of its leading node. Returns the number of both-face contacts left.
+int exclude_infeasible_pairs(const CollisionModel& model, CollisionData& data);
+// Stage 4 (enforced_displacement.cpp): writes soft node positions / velocities.
+struct DisplacementCounts {
+  int displaced = 0;
+  int guard_corrections = 0;
+};
+DisplacementCounts enforce_displacement(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft,
+                                        CollisionData& data);
+// Stage 5 (hunt_crossley_force.cpp): HC per contacted triangle, summed; fills out.contacts.
+void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft,
+                         CollisionData& data, CollisionStepResult& out);
+
+}  // namespace fissure::host::thin_body

@@ -1,0 +1,206 @@
+// Stage 4: enforced displacement (BRIEF §3 item 4; Fukuhara et al.: the soft nodes are moved, not
+// pushed by a penalty spring). Works on the tool-frame end positions from the broad phase and
+// writes btSoftBody::Node::m_x / m_v for every node it moves. Nodes of mass 0 (m_im == 0, fixed)
+// are never moved.
+//
+// paired:
+//  a. every vertex of a contacted triangle that is behind the leading node's tool plane is put
+//     on that plane (+ skin) — but only if it came from that plane's side: at the start of the
+//     step it was in front of the plane, or it was held on a plane facing the same way last step
+//     (soft-node side memory). So no vertex is ever moved THROUGH the tool;
+//  b. guard: every soft node near the tool whose relative path over the step (start → end, tool
+//     frame) enters the tool volume is put back on the plane it entered through (Cyrus–Beck
+//     clipping against the tool's convex planes); a node that starts inside (the soft solver
+//     pushed a held node in) goes back to the plane it was held on, else to the nearest one.
+//     This covers the tool's area between nodes and its rim. Triangles around a guarded node count
+//     as contacted (they have a colliding node) for the force.
+// ray (the paper's Fig. 3 right): every tool node in contact, excluded or not, puts its triangle's
+// vertices on ITS OWN plane when behind it, in node order — with both faces in contact the last
+// one wins, so vertices get pushed to the far face: the instability the pairing removes.
+// Every moved node gets the tool's velocity at its position.
+#include "collision_state.hpp"
+
+#include <BulletSoftBody/btSoftBody.h>
+
+#include <limits>
+
+namespace fissure::host::thin_body {
+namespace {
+
+// A node counts as inside the tool only beyond this depth (float noise of positions written at +skin).
+constexpr double kInsideTolerance_m = 1e-7;
+// Two tool planes "face the same way" (a node held on one may be moved to the other) above this cosine.
+constexpr double kSameSideCosine = 0.5;
+
+struct Writer {
+  const CollisionModel& model;
+  const StepFrame& frame;
+  btSoftBody& soft;
+  CollisionData& data;
+  DisplacementCounts counts;
+
+  bool fixed(int node) const { return soft.m_nodes[node].m_im == 0; }
+
+  // Moves the node's end position onto `plane` (+ skin) if it is behind it.
+  bool place_on_plane(int node, int plane_index) {
+    const ToolPlane& plane = model.tool.planes()[static_cast<std::size_t>(plane_index)];
+    Eigen::Vector3d& p = data.end_tool_m[static_cast<std::size_t>(node)];
+    const double target = plane.offset_m + model.params.skin_m;
+    const double height = plane.normal_tool.dot(p);
+    if (height >= target) return false;
+    p += (target - height) * plane.normal_tool;
+    write(node, plane_index);
+    return true;
+  }
+
+  void write(int node, int plane_index) {
+    const auto n = static_cast<std::size_t>(node);
+    const Eigen::Vector3d p_world = frame.r_cur * data.end_tool_m[n] + frame.t_cur;
+    const Eigen::Vector3d v_world = frame.velocity_world_m_s + frame.angular_velocity_world.cross(p_world - frame.t_cur);
+    btSoftBody::Node& soft_node = soft.m_nodes[node];
+    soft_node.m_x.setValue(static_cast<btScalar>(p_world.x()), static_cast<btScalar>(p_world.y()),
+                           static_cast<btScalar>(p_world.z()));
+    soft_node.m_v.setValue(static_cast<btScalar>(v_world.x()), static_cast<btScalar>(v_world.y()),
+                           static_cast<btScalar>(v_world.z()));
+    if (data.moved_stamp[n] != frame.step) {
+      data.moved_stamp[n] = frame.step;
+      data.moved_nodes.push_back(node);
+      ++counts.displaced;
+    }
+    data.hold_stamp[n] = frame.step;
+    data.hold_plane[n] = plane_index;
+  }
+
+  bool held_last_step_facing(int node, const Eigen::Vector3d& normal) const {
+    const auto n = static_cast<std::size_t>(node);
+    if (data.hold_stamp[n] != frame.step - 1) return false;
+    return model.tool.planes()[static_cast<std::size_t>(data.hold_plane[n])].normal_tool.dot(normal) > kSameSideCosine;
+  }
+
+  // A face with a colliding soft node enters the force set on the plane that node is held on (the
+  // first colliding node found decides). A tool node that hit the face this step is kept as its
+  // leading node only if it lies on that same plane.
+  void add_force_face(int face, int plane_index) {
+    const auto f = static_cast<std::size_t>(face);
+    if (data.face_force_stamp[f] == frame.step) return;
+    data.face_force_stamp[f] = frame.step;
+    const bool hit_on_same_plane = data.face_contact_stamp[f] == frame.step && data.face_plane[f] == plane_index;
+    if (!hit_on_same_plane) data.face_lead_node[f] = -1;
+    data.face_plane[f] = plane_index;
+    data.contacted_faces.push_back(face);
+  }
+
+  void paired_faces() {
+    const double feasible_slack = model.params.contact_distance_m + model.params.skin_m;
+    for (const int face : data.contacted_faces) {
+      const int plane_index = data.face_plane[static_cast<std::size_t>(face)];
+      const ToolPlane& plane = model.tool.planes()[static_cast<std::size_t>(plane_index)];
+      for (const int node : model.soft.face_nodes[static_cast<std::size_t>(face)]) {
+        if (fixed(node)) continue;
+        const double start_height = plane.normal_tool.dot(data.start_tool_m[static_cast<std::size_t>(node)]);
+        const bool came_from_front = start_height >= plane.offset_m - feasible_slack;
+        if (came_from_front || held_last_step_facing(node, plane.normal_tool)) place_on_plane(node, plane_index);
+      }
+    }
+  }
+
+  void guard() {
+    const auto& planes = model.tool.planes();
+    const std::size_t plane_count = planes.size();
+    for (const int node : data.candidate_nodes) {
+      if (fixed(node)) continue;
+      const auto n = static_cast<std::size_t>(node);
+      const Eigen::Vector3d& a = data.start_tool_m[n];
+      const Eigen::Vector3d& b = data.end_tool_m[n];
+      double t_enter = 0.0;
+      double t_exit = 1.0;
+      int enter_plane = -1;
+      int nearest_plane = 0;
+      double nearest_height = -std::numeric_limits<double>::infinity();
+      bool misses = false;
+      for (std::size_t q = 0; q < plane_count; ++q) {
+        const double fa = planes[q].normal_tool.dot(a) - planes[q].offset_m + kInsideTolerance_m;
+        const double fb = planes[q].normal_tool.dot(b) - planes[q].offset_m + kInsideTolerance_m;
+        if (fa > nearest_height) {
+          nearest_height = fa;
+          nearest_plane = static_cast<int>(q);
+        }
+        if (fa > 0.0 && fb > 0.0) {
+          misses = true;
+          break;
+        }
+        if (fa > 0.0) {
+          const double t = fa / (fa - fb);
+          if (t > t_enter) {
+            t_enter = t;
+            enter_plane = static_cast<int>(q);
+          }
+        } else if (fb > 0.0) {
+          const double t = fa / (fa - fb);
+          if (t < t_exit) t_exit = t;
+        }
+      }
+      if (misses || t_enter > t_exit) continue;
+      int plane_index = enter_plane;
+      if (plane_index < 0) {
+        if (data.hold_stamp[n] >= frame.step - 1 && data.hold_plane[n] >= 0) {
+          plane_index = data.hold_plane[n];
+        } else {
+          plane_index = nearest_plane;  // started inside with no memory: the shallowest way out
+        }
+      }
+      if (place_on_plane(node, plane_index)) ++counts.guard_corrections;
+    }
+  }
+
+  void ray_only() {
+    const auto& plane_of_node = model.tool.plane_of_node();
+    for (const int i : data.contact_nodes) {
+      const int face = data.node_face[static_cast<std::size_t>(i)];
+      if (face < 0) continue;
+      const int plane_index = plane_of_node[static_cast<std::size_t>(i)];
+      for (const int node : model.soft.face_nodes[static_cast<std::size_t>(face)])
+        if (!fixed(node)) place_on_plane(node, plane_index);
+      data.face_plane[static_cast<std::size_t>(face)] = plane_index;  // last writer, as placed
+    }
+  }
+};
+
+}  // namespace
+
+DisplacementCounts enforce_displacement(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft,
+                                        CollisionData& data) {
+  Writer writer{model, frame, soft, data, DisplacementCounts{}};
+  data.moved_nodes.clear();
+  if (model.paired) {
+    writer.paired_faces();
+    writer.guard();
+  } else {
+    writer.ray_only();
+  }
+  // Hysteresis: a node held last step and still within release_distance in front of its plane
+  // stays colliding (not moved).
+  const auto& planes = model.tool.planes();
+  for (const int node : data.candidate_nodes) {
+    const auto n = static_cast<std::size_t>(node);
+    if (data.hold_stamp[n] != frame.step - 1 || data.moved_stamp[n] == frame.step) continue;
+    const ToolPlane& plane = planes[static_cast<std::size_t>(data.hold_plane[n])];
+    const double gap = plane.normal_tool.dot(data.end_tool_m[n]) - plane.offset_m;
+    if (gap < 0.0 || gap > model.params.release_distance_m) continue;
+    data.hold_stamp[n] = frame.step;
+    data.moved_stamp[n] = frame.step;
+    data.moved_nodes.push_back(node);
+  }
+  // Paper: "the calculation of x is executed if and only if at least one of the nodes belonging to
+  // the triangle is in a colliding state" — the force set is every triangle around a colliding
+  // soft node (displaced this step, or held within the release distance).
+  data.contacted_faces.clear();
+  for (const int node : data.moved_nodes) {
+    const auto n = static_cast<std::size_t>(node);
+    for (int k = model.soft.faces_of_node_begin[n]; k < model.soft.faces_of_node_begin[n + 1]; ++k)
+      writer.add_force_face(model.soft.faces_of_node[static_cast<std::size_t>(k)], data.hold_plane[n]);
+  }
+  return writer.counts;
+}
+
+}  // namespace fissure::host::thin_body

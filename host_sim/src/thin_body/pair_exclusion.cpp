@@ -1,0 +1,93 @@
+// Stage 3: infeasible-pair exclusion (BRIEF §3 item 3; paper: "when a node belongs to an
+// infeasible pair, the associated index is stored in a vector collecting all the indices of the
+// nodes that cannot collide in the current simulation step. Thus, a cross-check is necessary at
+// each step").
+//
+// Both nodes of a pair in contact means the soft surface is on both faces of a tool thinner than
+// the step — only one face can be feasible: the one that LED. Leading is decided by
+//   1. side memory: the node that has been in contact for more consecutive steps came first;
+//   2. facing: the node whose face meets its triangle head-on (tool normal · soft normal most
+//      negative) rather than from behind;
+//   3. the earlier crossing within the step (τ);
+//   4. the lower node index (determinism).
+// Pairs from a convex mesh are not always mutual, so every node in contact is checked against
+// its own pair AND against every node that chose it as a pair (ToolNodes::paired_by): the
+// cross-check. The ray-only variant skips this stage (both faces push).
+//
+// Then every contacted soft face gets the tool plane of its leading (non-excluded) node.
+#include "collision_state.hpp"
+
+#include <cmath>
+
+namespace fissure::host::thin_body {
+namespace {
+
+// Two facing values / crossing times closer than this are treated as a tie.
+constexpr double kTie = 1e-9;
+
+bool leads(const CollisionData& data, int i, int j) {
+  const auto a = static_cast<std::size_t>(i);
+  const auto b = static_cast<std::size_t>(j);
+  if (data.node_age[a] != data.node_age[b]) return data.node_age[a] > data.node_age[b];
+  if (std::abs(data.node_facing[a] - data.node_facing[b]) > kTie) return data.node_facing[a] < data.node_facing[b];
+  if (std::abs(data.node_tau[a] - data.node_tau[b]) > kTie) return data.node_tau[a] < data.node_tau[b];
+  return i < j;
+}
+
+bool in_contact(const CollisionData& data, int node) { return node >= 0 && data.node_face[static_cast<std::size_t>(node)] >= 0; }
+
+}  // namespace
+
+int exclude_infeasible_pairs(const CollisionModel& model, CollisionData& data) {
+  data.exclusion.clear();
+  const auto& pair_of = model.tool.pair_of();
+  const auto& by_begin = model.tool.paired_by_begin();
+  const auto& by_nodes = model.tool.paired_by_nodes();
+  if (model.paired && model.tool.is_thin()) {
+    for (const int i : data.contact_nodes) {
+      bool loses = false;
+      const int pair = pair_of[static_cast<std::size_t>(i)];
+      if (in_contact(data, pair) && !leads(data, i, pair)) loses = true;
+      for (int k = by_begin[static_cast<std::size_t>(i)]; !loses && k < by_begin[static_cast<std::size_t>(i + 1)]; ++k) {
+        const int other = by_nodes[static_cast<std::size_t>(k)];
+        if (in_contact(data, other) && !leads(data, i, other)) loses = true;
+      }
+      if (loses) data.exclusion.push_back(i);
+    }
+    // Decisions above were taken on the contact state before any exclusion (the cross-check is
+    // symmetric); now the excluded nodes stop colliding for this step and lose their memory.
+    for (const int i : data.exclusion) {
+      data.node_excluded_stamp[static_cast<std::size_t>(i)] = data.step;
+      data.node_face[static_cast<std::size_t>(i)] = -1;
+      data.node_age[static_cast<std::size_t>(i)] = 0;
+    }
+  }
+  // Both-face contacts left (the ray-only variant's instability; 0 for paired by construction).
+  int both_face = 0;
+  for (const int i : data.contact_nodes) {
+    const int pair = pair_of[static_cast<std::size_t>(i)];
+    if (!in_contact(data, i) || !in_contact(data, pair)) continue;
+    // Count a mutual pair once, a one-way pair from its source.
+    if (pair_of[static_cast<std::size_t>(pair)] != i || i < pair) ++both_face;
+  }
+  // Contacted faces and the plane each is placed on.
+  data.contacted_faces.clear();
+  const auto& plane_of_node = model.tool.plane_of_node();
+  for (const int i : data.contact_nodes) {
+    const int face = data.node_face[static_cast<std::size_t>(i)];
+    if (face < 0) continue;
+    const auto f = static_cast<std::size_t>(face);
+    if (data.face_contact_stamp[f] != data.step) {
+      data.face_contact_stamp[f] = data.step;
+      data.contacted_faces.push_back(face);
+      data.face_lead_node[f] = i;
+      data.face_plane[f] = plane_of_node[static_cast<std::size_t>(i)];
+    } else if (model.paired && leads(data, i, data.face_lead_node[f])) {
+      data.face_lead_node[f] = i;
+      data.face_plane[f] = plane_of_node[static_cast<std::size_t>(i)];
+    }
+  }
+  return both_face;
+}
+
+}  // namespace fissure::host::thin_body

@@ -1,0 +1,272 @@
+// ToolNodes: node placement and pairing at load (BRIEF §3 item 1; paper "Extension of the
+// algorithm to convex thin bodies").
+#include <fissure/host_sim/thin_tool.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace fissure::host {
+namespace {
+
+// Relative tolerance for "coplanar" when merging mesh triangles into tool planes and checking
+// convexity: meshes come from float OBJ files, so 1e-6 of the tool size.
+constexpr double kPlaneTolerance_relative = 1e-6;
+
+int other_axis_u(int thin_axis) { return thin_axis == 0 ? 1 : 0; }
+int other_axis_v(int thin_axis) { return thin_axis == 2 ? 1 : 2; }
+
+// 2-D convex hull (Andrew's monotone chain), counter-clockwise.
+std::vector<Eigen::Vector2d> convex_hull_2d(std::vector<Eigen::Vector2d> points) {
+  std::sort(points.begin(), points.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  if (points.size() < 3) return points;
+  std::vector<Eigen::Vector2d> hull(2 * points.size());
+  const auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+  };
+  std::size_t k = 0;
+  for (const auto& p : points) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], p) <= 0) --k;
+    hull[k++] = p;
+  }
+  for (std::size_t i = points.size() - 1, t = k + 1; i > 0; --i) {
+    const auto& p = points[i - 1];
+    while (k >= t && cross(hull[k - 2], hull[k - 1], p) <= 0) --k;
+    hull[k++] = p;
+  }
+  hull.resize(k - 1);
+  return hull;
+}
+
+// Möller–Trumbore, two-sided; returns the ray parameter or +inf.
+double ray_triangle(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, const Eigen::Vector3d& a,
+                    const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d e1 = b - a;
+  const Eigen::Vector3d e2 = c - a;
+  const Eigen::Vector3d pvec = dir.cross(e2);
+  const double det = e1.dot(pvec);
+  if (std::abs(det) < 1e-300) return std::numeric_limits<double>::infinity();
+  const double inv_det = 1.0 / det;
+  const Eigen::Vector3d tvec = origin - a;
+  const double u = tvec.dot(pvec) * inv_det;
+  if (u < -1e-12 || u > 1.0 + 1e-12) return std::numeric_limits<double>::infinity();
+  const Eigen::Vector3d qvec = tvec.cross(e1);
+  const double v = dir.dot(qvec) * inv_det;
+  if (v < -1e-12 || u + v > 1.0 + 1e-12) return std::numeric_limits<double>::infinity();
+  return e2.dot(qvec) * inv_det;
+}
+
+}  // namespace
+
+ToolNodes ToolNodes::from_box(const BoxToolShape& shape) {
+  if (shape.thin_axis < 0 || shape.thin_axis > 2)
+    throw std::invalid_argument("box tool: thin_axis must be 0, 1 or 2, got " + std::to_string(shape.thin_axis));
+  if (!(shape.half_extents_m.array() > 0.0).all() || !shape.half_extents_m.allFinite())
+    throw std::invalid_argument("box tool: half_extents_m must be finite and > 0");
+  if (shape.nodes_u < 1 || shape.nodes_v < 1)
+    throw std::invalid_argument("box tool: nodes_u and nodes_v must be >= 1");
+  ToolNodes tool;
+  const int w = shape.thin_axis;
+  const int u = other_axis_u(w);
+  const int v = other_axis_v(w);
+  const Eigen::Vector3d& h = shape.half_extents_m;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (const double sign : {1.0, -1.0}) {
+      ToolPlane plane;
+      plane.normal_tool = sign * Eigen::Vector3d::Unit(axis);
+      plane.offset_m = h[axis];
+      tool.planes_.push_back(plane);
+    }
+  }
+  const int per_face = shape.nodes_u * shape.nodes_v;
+  // Grid including the face's edges, so that soft triangles straddling the rim are still swept by
+  // a node (the face interior between nodes is covered by the soft-node guard of the response).
+  const auto grid = [](int count, int index, double half) {
+    return count == 1 ? 0.0 : -half + 2.0 * half * static_cast<double>(index) / static_cast<double>(count - 1);
+  };
+  for (const double sign : {1.0, -1.0}) {
+    for (int iu = 0; iu < shape.nodes_u; ++iu) {
+      for (int iv = 0; iv < shape.nodes_v; ++iv) {
+        Eigen::Vector3d p = Eigen::Vector3d::Zero();
+        p[w] = sign * h[w];
+        p[u] = grid(shape.nodes_u, iu, h[u]);
+        p[v] = grid(shape.nodes_v, iv, h[v]);
+        tool.positions_tool_m_.push_back(p);
+        tool.normals_tool_.push_back(sign * Eigen::Vector3d::Unit(w));
+        tool.plane_of_node_.push_back(2 * w + (sign > 0 ? 0 : 1));
+      }
+    }
+  }
+  tool.pair_of_.resize(static_cast<std::size_t>(2 * per_face));
+  for (int i = 0; i < per_face; ++i) {
+    tool.pair_of_[static_cast<std::size_t>(i)] = i + per_face;
+    tool.pair_of_[static_cast<std::size_t>(i + per_face)] = i;
+  }
+  for (int corner = 0; corner < 8; ++corner) {
+    tool.hull_vertices_tool_m_.emplace_back((corner & 1) ? h.x() : -h.x(), (corner & 2) ? h.y() : -h.y(),
+                                            (corner & 4) ? h.z() : -h.z());
+  }
+  tool.thin_axis_ = w;
+  tool.thickness_m_ = 2.0 * h[w];
+  tool.finish_pairing();
+  tool.thin_ = true;  // a box tool is the paper's spatula: always paired
+  return tool;
+}
+
+ToolNodes ToolNodes::from_convex_mesh(const ConvexMeshToolShape& shape) {
+  const auto& verts = shape.vertices_tool_m;
+  if (verts.size() < 4 || shape.triangles.size() < 4)
+    throw std::invalid_argument("convex tool mesh: needs at least 4 vertices and 4 triangles");
+  for (const auto& p : verts)
+    if (!p.allFinite()) throw std::invalid_argument("convex tool mesh: non-finite vertex");
+  if (!std::isfinite(shape.pairing_ray_limit_m))
+    throw std::invalid_argument("convex tool mesh: pairing_ray_limit_m must be finite");
+  ToolNodes tool;
+  for (const auto& p : verts) tool.bounds_tool_m_.extend(p);
+  const double size_m = tool.bounds_tool_m_.diagonal().norm();
+  const double tol_m = kPlaneTolerance_relative * size_m;
+
+  // Signed volume decides the winding (outward normals wanted).
+  double volume6 = 0.0;
+  for (const auto& t : shape.triangles) {
+    for (const int index : t)
+      if (index < 0 || index >= static_cast<int>(verts.size()))
+        throw std::invalid_argument("convex tool mesh: triangle index " + std::to_string(index) + " out of range");
+    volume6 += verts[static_cast<std::size_t>(t[0])].dot(
+        verts[static_cast<std::size_t>(t[1])].cross(verts[static_cast<std::size_t>(t[2])]));
+  }
+  if (std::abs(volume6) <= 1e-12 * size_m * size_m * size_m)
+    throw std::invalid_argument("convex tool mesh: zero volume (open or flat mesh)");
+  const double winding = volume6 > 0.0 ? 1.0 : -1.0;
+
+  std::vector<Eigen::Vector3d> tri_normal;
+  std::vector<Eigen::Vector3d> tri_a, tri_b, tri_c;
+  for (const auto& t : shape.triangles) {
+    const Eigen::Vector3d& a = verts[static_cast<std::size_t>(t[0])];
+    const Eigen::Vector3d& b = verts[static_cast<std::size_t>(t[1])];
+    const Eigen::Vector3d& c = verts[static_cast<std::size_t>(t[2])];
+    const Eigen::Vector3d n = winding * (b - a).cross(c - a);
+    if (n.norm() <= 1e-12 * size_m * size_m)
+      throw std::invalid_argument("convex tool mesh: degenerate (zero-area) triangle");
+    tri_normal.push_back(n.normalized());
+    tri_a.push_back(a);
+    tri_b.push_back(b);
+    tri_c.push_back(c);
+  }
+  // Planes: merge coplanar triangles (a flat face is one plane), check convexity.
+  for (std::size_t f = 0; f < tri_normal.size(); ++f) {
+    const double offset = tri_normal[f].dot(tri_a[f]);
+    for (const auto& p : verts)
+      if (tri_normal[f].dot(p) - offset > tol_m)
+        throw std::invalid_argument("convex tool mesh: not convex (a vertex lies outside triangle " +
+                                    std::to_string(f) + "'s plane)");
+    int plane_index = -1;
+    for (std::size_t q = 0; q < tool.planes_.size(); ++q) {
+      if (tool.planes_[q].normal_tool.dot(tri_normal[f]) > 1.0 - 1e-9 &&
+          std::abs(tool.planes_[q].offset_m - offset) <= tol_m) {
+        plane_index = static_cast<int>(q);
+        break;
+      }
+    }
+    if (plane_index < 0) {
+      plane_index = static_cast<int>(tool.planes_.size());
+      tool.planes_.push_back(ToolPlane{tri_normal[f], offset});
+    }
+    tool.positions_tool_m_.push_back((tri_a[f] + tri_b[f] + tri_c[f]) / 3.0);
+    tool.normals_tool_.push_back(tri_normal[f]);
+    tool.plane_of_node_.push_back(plane_index);
+  }
+  // Pairing: a ray from each centroid opposite to its normal, limited to pairing_ray_limit_m;
+  // the nearest other triangle hit gives the pair (paper Fig. 2: the limit stops rim nodes
+  // pairing across the edge).
+  const std::size_t count = tri_normal.size();
+  tool.pair_of_.assign(count, -1);
+  if (shape.pairing_ray_limit_m > 0.0) {
+    const double t_min = tol_m;  // skip the node's own plane (and coplanar neighbours)
+    for (std::size_t i = 0; i < count; ++i) {
+      const Eigen::Vector3d origin = tool.positions_tool_m_[i];
+      const Eigen::Vector3d dir = -tri_normal[i];
+      double best_t = shape.pairing_ray_limit_m;
+      int best = -1;
+      for (std::size_t j = 0; j < count; ++j) {
+        if (j == i) continue;
+        const double t = ray_triangle(origin, dir, tri_a[j], tri_b[j], tri_c[j]);
+        if (t > t_min && t <= best_t) {
+          best_t = t;
+          best = static_cast<int>(j);
+        }
+      }
+      tool.pair_of_[i] = best;
+    }
+  }
+  tool.hull_vertices_tool_m_ = verts;
+  const Eigen::Vector3d extent = tool.bounds_tool_m_.sizes();
+  extent.minCoeff(&tool.thin_axis_);
+  tool.thickness_m_ = extent[tool.thin_axis_];
+  tool.finish_pairing();
+  tool.thin_ = shape.pairing_ray_limit_m > 0.0 && tool.report_.mutual + tool.report_.one_way > 0;
+  return tool;
+}
+
+void ToolNodes::finish_pairing() {
+  const int count = node_count();
+  paired_by_begin_.assign(static_cast<std::size_t>(count + 1), 0);
+  for (const int pair : pair_of_)
+    if (pair >= 0) ++paired_by_begin_[static_cast<std::size_t>(pair + 1)];
+  for (int i = 0; i < count; ++i)
+    paired_by_begin_[static_cast<std::size_t>(i + 1)] += paired_by_begin_[static_cast<std::size_t>(i)];
+  paired_by_nodes_.assign(static_cast<std::size_t>(paired_by_begin_.back()), -1);
+  std::vector<int> fill(paired_by_begin_.begin(), paired_by_begin_.end() - 1);
+  for (int i = 0; i < count; ++i) {
+    const int pair = pair_of_[static_cast<std::size_t>(i)];
+    if (pair >= 0) paired_by_nodes_[static_cast<std::size_t>(fill[static_cast<std::size_t>(pair)]++)] = i;
+  }
+  report_ = PairingReport{};
+  for (int i = 0; i < count; ++i) {
+    const int pair = pair_of_[static_cast<std::size_t>(i)];
+    if (pair < 0) {
+      ++report_.unpaired;
+    } else if (pair_of_[static_cast<std::size_t>(pair)] == i) {
+      ++report_.mutual;
+    } else {
+      ++report_.one_way;
+    }
+  }
+  bounds_tool_m_.setEmpty();
+  for (const auto& p : hull_vertices_tool_m_) bounds_tool_m_.extend(p);
+  // Footprint seen along the thin axis.
+  const int u = other_axis_u(thin_axis_);
+  const int v = other_axis_v(thin_axis_);
+  std::vector<Eigen::Vector2d> projected;
+  for (const auto& p : hull_vertices_tool_m_) projected.emplace_back(p[u], p[v]);
+  const auto hull = convex_hull_2d(projected);
+  footprint_halfplanes_.clear();
+  for (std::size_t i = 0; i < hull.size(); ++i) {
+    const Eigen::Vector2d& a = hull[i];
+    const Eigen::Vector2d& b = hull[(i + 1) % hull.size()];
+    const Eigen::Vector2d edge = b - a;
+    const Eigen::Vector2d outward(edge.y(), -edge.x());  // CCW hull: right-hand normal points out
+    const Eigen::Vector2d n = outward.normalized();
+    footprint_halfplanes_.emplace_back(n.x(), n.y(), n.dot(a));
+  }
+}
+
+double ToolNodes::signed_distance_m(const Eigen::Vector3d& p_tool) const {
+  double distance = -std::numeric_limits<double>::infinity();
+  for (const auto& plane : planes_) distance = std::max(distance, plane.normal_tool.dot(p_tool) - plane.offset_m);
+  return distance;
+}
+
+bool ToolNodes::in_footprint(const Eigen::Vector3d& p_tool) const {
+  const double pu = p_tool[other_axis_u(thin_axis_)];
+  const double pv = p_tool[other_axis_v(thin_axis_)];
+  for (const auto& h : footprint_halfplanes_)
+    if (h.x() * pu + h.y() * pv > h.z()) return false;
+  return !footprint_halfplanes_.empty();
+}
+
+}  // namespace fissure::host

@@ -1,0 +1,192 @@
+// ToolNodes: node placement and pairing at load (BRIEF §3 item 1), and the generated convex
+// spatula mesh with rounded rims (paper Fig. 1 middle / Fig. 2).
+#include <fissure/host_sim/thin_tool.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+
+namespace fissure::host {
+namespace {
+
+BoxToolShape plate_shape() {
+  BoxToolShape shape;
+  shape.half_extents_m = Eigen::Vector3d(0.02, 0.002, 0.02);
+  shape.thin_axis = 1;
+  shape.nodes_u = 9;
+  shape.nodes_v = 7;
+  return shape;
+}
+
+TEST(ToolNodesBox, GridOnBothLargeFacesPairedAcrossTheThickness) {
+  const ToolNodes tool = ToolNodes::from_box(plate_shape());
+  ASSERT_EQ(tool.node_count(), 2 * 9 * 7);
+  EXPECT_EQ(tool.pairing_report().mutual, 2 * 9 * 7);
+  EXPECT_EQ(tool.pairing_report().one_way, 0);
+  EXPECT_EQ(tool.pairing_report().unpaired, 0);
+  EXPECT_TRUE(tool.is_thin());
+  EXPECT_EQ(tool.thin_axis(), 1);
+  EXPECT_DOUBLE_EQ(tool.thickness_m(), 0.004);
+  for (int i = 0; i < tool.node_count(); ++i) {
+    const auto& p = tool.positions_tool_m()[static_cast<std::size_t>(i)];
+    const auto& n = tool.normals_tool()[static_cast<std::size_t>(i)];
+    const int pair = tool.pair_of()[static_cast<std::size_t>(i)];
+    const auto& q = tool.positions_tool_m()[static_cast<std::size_t>(pair)];
+    EXPECT_NEAR(std::abs(p.y()), 0.002, 1e-15) << "node on a large face";
+    EXPECT_DOUBLE_EQ(n.y(), p.y() > 0 ? 1.0 : -1.0) << "outward normal";
+    EXPECT_DOUBLE_EQ(p.x(), q.x());
+    EXPECT_DOUBLE_EQ(p.z(), q.z());
+    EXPECT_DOUBLE_EQ(p.y(), -q.y()) << "pair across the thickness";
+    EXPECT_EQ(tool.pair_of()[static_cast<std::size_t>(pair)], i);
+    // The node's plane is the face it lies on.
+    const ToolPlane& plane = tool.planes()[static_cast<std::size_t>(tool.plane_of_node()[static_cast<std::size_t>(i)])];
+    EXPECT_NEAR(plane.normal_tool.dot(p) - plane.offset_m, 0.0, 1e-15);
+    EXPECT_DOUBLE_EQ(plane.normal_tool.dot(n), 1.0);
+  }
+  // Grid covers the face to its edges.
+  double max_x = 0.0;
+  for (const auto& p : tool.positions_tool_m()) max_x = std::max(max_x, p.x());
+  EXPECT_DOUBLE_EQ(max_x, 0.02);
+}
+
+TEST(ToolNodesBox, SignedDistanceAndFootprint) {
+  const ToolNodes tool = ToolNodes::from_box(plate_shape());
+  EXPECT_NEAR(tool.signed_distance_m(Eigen::Vector3d(0, 0, 0)), -0.002, 1e-15);
+  EXPECT_NEAR(tool.signed_distance_m(Eigen::Vector3d(0.01, 0.0015, 0)), -0.0005, 1e-15);
+  EXPECT_NEAR(tool.signed_distance_m(Eigen::Vector3d(0, -0.003, 0)), 0.001, 1e-15);
+  EXPECT_TRUE(tool.in_footprint(Eigen::Vector3d(0.019, 0.5, -0.019)));
+  EXPECT_FALSE(tool.in_footprint(Eigen::Vector3d(0.021, 0.0, 0.0)));
+}
+
+TEST(ToolNodesBox, RejectsBadShapes) {
+  BoxToolShape shape = plate_shape();
+  shape.thin_axis = 3;
+  EXPECT_THROW((void)ToolNodes::from_box(shape), std::invalid_argument);
+  shape = plate_shape();
+  shape.nodes_u = 0;
+  EXPECT_THROW((void)ToolNodes::from_box(shape), std::invalid_argument);
+  shape = plate_shape();
+  shape.half_extents_m.y() = 0.0;
+  EXPECT_THROW((void)ToolNodes::from_box(shape), std::invalid_argument);
+}
+
+constexpr double kThickness_m = 0.002;
+
+TEST(RoundedSpatulaMesh, IsAClosedConvexThinMeshWithManyRimTriangles) {
+  RoundedSpatulaParams params;
+  params.thickness_m = kThickness_m;
+  const ConvexMeshToolShape mesh = make_rounded_spatula_mesh(params, 3.0 * kThickness_m);
+  const ToolNodes tool = ToolNodes::from_convex_mesh(mesh);  // throws if not convex / closed
+  EXPECT_EQ(tool.node_count(), static_cast<int>(mesh.triangles.size()));
+  EXPECT_EQ(tool.thin_axis(), 1);
+  EXPECT_NEAR(tool.thickness_m(), kThickness_m, 1e-12);
+  // The sampled rim profile lies inside the true half circle (chord sag ≤ r·(1 − cos(π/2/segments))).
+  EXPECT_LE(tool.bounds_tool_m().sizes().x(), params.length_m + 1e-12);
+  EXPECT_NEAR(tool.bounds_tool_m().sizes().x(), params.length_m, 1e-4);
+  EXPECT_NEAR(tool.bounds_tool_m().sizes().z(), params.width_m, 1e-4);
+  // Every node's plane passes through it with the node's normal; the flat faces merge to one plane each.
+  int on_top = 0;
+  for (int i = 0; i < tool.node_count(); ++i) {
+    const auto& p = tool.positions_tool_m()[static_cast<std::size_t>(i)];
+    const ToolPlane& plane = tool.planes()[static_cast<std::size_t>(tool.plane_of_node()[static_cast<std::size_t>(i)])];
+    EXPECT_NEAR(plane.normal_tool.dot(p), plane.offset_m, 1e-12);
+    EXPECT_GT(plane.normal_tool.dot(tool.normals_tool()[static_cast<std::size_t>(i)]), 1.0 - 1e-9);
+    if (tool.normals_tool()[static_cast<std::size_t>(i)].y() > 1.0 - 1e-12) ++on_top;
+  }
+  EXPECT_GT(on_top, 20);
+  EXPECT_LT(static_cast<int>(tool.planes().size()), tool.node_count()) << "coplanar triangles share a plane";
+  // Rim triangles (paper Fig. 2): centroids far closer to one another than the thickness.
+  double min_rim_spacing = 1.0;
+  for (int i = 0; i < tool.node_count(); ++i) {
+    if (std::abs(tool.normals_tool()[static_cast<std::size_t>(i)].y()) > 0.999) continue;
+    for (int j = i + 1; j < tool.node_count(); ++j) {
+      if (std::abs(tool.normals_tool()[static_cast<std::size_t>(j)].y()) > 0.999) continue;
+      min_rim_spacing = std::min(min_rim_spacing, (tool.positions_tool_m()[static_cast<std::size_t>(i)] -
+                                                   tool.positions_tool_m()[static_cast<std::size_t>(j)]).norm());
+    }
+  }
+  EXPECT_LT(min_rim_spacing, 0.5 * kThickness_m);
+}
+
+// The paper's Fig. 2 problem and its fix: with an unlimited ray, rim nodes pair with nodes on the
+// far side of the tool (across the edge); the limited ray leaves them unpaired instead.
+TEST(ToolNodesConvexMesh, LimitedRayStopsRimNodesPairingAcrossTheEdge) {
+  RoundedSpatulaParams params;
+  params.thickness_m = kThickness_m;
+  const double limit = 3.0 * kThickness_m;
+  const ToolNodes limited = ToolNodes::from_convex_mesh(make_rounded_spatula_mesh(params, limit));
+  const ToolNodes unlimited = ToolNodes::from_convex_mesh(make_rounded_spatula_mesh(params, 1.0));
+
+  // How far apart (across the tool's plane, x–z) a node and its pair lie: a pair across the edge
+  // of Fig. 2 joins opposite rims, a tool width apart.
+  const auto widest_pair = [](const ToolNodes& tool) {
+    double widest = 0.0;
+    for (int i = 0; i < tool.node_count(); ++i) {
+      const int pair = tool.pair_of()[static_cast<std::size_t>(i)];
+      if (pair < 0) continue;
+      Eigen::Vector3d d = tool.positions_tool_m()[static_cast<std::size_t>(i)] - tool.positions_tool_m()[static_cast<std::size_t>(pair)];
+      d.y() = 0.0;
+      widest = std::max(widest, d.norm());
+    }
+    return widest;
+  };
+  EXPECT_GT(widest_pair(unlimited), 0.5 * params.width_m) << "unlimited rays pair across the whole tool";
+  EXPECT_LT(widest_pair(limited), 0.25 * params.width_m) << "the limited ray keeps pairs local";
+  EXPECT_GT(limited.pairing_report().unpaired, unlimited.pairing_report().unpaired);
+
+  for (const ToolNodes* tool : {&limited, &unlimited}) {
+    const PairingReport& r = tool->pairing_report();
+    EXPECT_EQ(r.mutual + r.one_way + r.unpaired, tool->node_count());
+    EXPECT_GT(r.mutual, 0);
+    EXPECT_GT(r.one_way, 0) << "pairs on a mesh are not always mutual (paper)";
+    EXPECT_TRUE(tool->is_thin());
+  }
+  // Flat-face nodes pair straight across the thickness.
+  for (int i = 0; i < limited.node_count(); ++i) {
+    if (limited.normals_tool()[static_cast<std::size_t>(i)].y() < 1.0 - 1e-12) continue;
+    const int pair = limited.pair_of()[static_cast<std::size_t>(i)];
+    ASSERT_GE(pair, 0);
+    EXPECT_NEAR(limited.positions_tool_m()[static_cast<std::size_t>(pair)].y(), -0.5 * kThickness_m, 1e-12);
+  }
+  // paired_by is the exact reverse of pair_of.
+  int reverse_entries = 0;
+  for (int i = 0; i < limited.node_count(); ++i) {
+    for (int k = limited.paired_by_begin()[static_cast<std::size_t>(i)]; k < limited.paired_by_begin()[static_cast<std::size_t>(i + 1)]; ++k) {
+      EXPECT_EQ(limited.pair_of()[static_cast<std::size_t>(limited.paired_by_nodes()[static_cast<std::size_t>(k)])], i);
+      ++reverse_entries;
+    }
+  }
+  EXPECT_EQ(reverse_entries, limited.pairing_report().mutual + limited.pairing_report().one_way);
+}
+
+TEST(ToolNodesConvexMesh, NoRayLimitMeansNotThin) {
+  RoundedSpatulaParams params;
+  const ToolNodes tool = ToolNodes::from_convex_mesh(make_rounded_spatula_mesh(params, 0.0));
+  EXPECT_FALSE(tool.is_thin());
+  EXPECT_EQ(tool.pairing_report().unpaired, tool.node_count());
+}
+
+TEST(ToolNodesConvexMesh, RejectsNonConvexAndBrokenMeshes) {
+  ConvexMeshToolShape mesh = make_rounded_spatula_mesh(RoundedSpatulaParams{}, 0.006);
+  ConvexMeshToolShape dented = mesh;
+  dented.vertices_tool_m.front() *= 0.5;  // pull a rim vertex inward: a dent
+  EXPECT_THROW((void)ToolNodes::from_convex_mesh(dented), std::invalid_argument);
+  ConvexMeshToolShape bad_index = mesh;
+  bad_index.triangles.front()[0] = static_cast<int>(mesh.vertices_tool_m.size());
+  EXPECT_THROW((void)ToolNodes::from_convex_mesh(bad_index), std::invalid_argument);
+  ConvexMeshToolShape too_small;
+  EXPECT_THROW((void)ToolNodes::from_convex_mesh(too_small), std::invalid_argument);
+  // Winding does not matter: a fully flipped mesh gives the same planes.
+  ConvexMeshToolShape flipped = mesh;
+  for (auto& t : flipped.triangles) std::swap(t[1], t[2]);
+  const ToolNodes a = ToolNodes::from_convex_mesh(mesh);
+  const ToolNodes b = ToolNodes::from_convex_mesh(flipped);
+  ASSERT_EQ(a.node_count(), b.node_count());
+  for (int i = 0; i < a.node_count(); ++i)
+    EXPECT_TRUE(a.normals_tool()[static_cast<std::size_t>(i)].isApprox(b.normals_tool()[static_cast<std::size_t>(i)]));
+  EXPECT_NEAR(a.signed_distance_m(Eigen::Vector3d::Zero()), -0.001, 1e-9);
+}
+
+}  // namespace
+}  // namespace fissure::host
