@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <new>
+#include <random>
 #include <string>
 
 // Counts heap allocations so a test can assert that step() allocates nothing in steady state.
@@ -176,6 +177,58 @@ TEST(PairedCollision, StepDoesNotAllocateInContact) {
   }
   EXPECT_GT(contact_steps, 100);
   EXPECT_EQ(allocations_in_steps, 0);
+}
+
+// Invariant fuzz: random tool orientations, approach directions, speeds (0.1–20 m/s) and spins
+// (≤ 5 rad/s) through the sphere — no crossed node, no node deeper than 0.1 mm in the tool,
+// finite forces and positions. Fixed seed: deterministic.
+TEST(PairedCollision, RandomPosesVelocitiesAndSpinsKeepTheInvariants) {
+  std::mt19937 rng(20261121);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_real_distribution<double> speed_log10(-1.0, std::log10(20.0));
+  const ToolNodes plate = test_scene::plate_tool(0.002);
+  const ToolNodes spatula = make_tool(Tool::kConvexSpatula);
+  const Eigen::Vector3d centre(0, test_scene::kSphereRadius_m, 0);
+  int runs_with_contact = 0;
+  for (int run = 0; run < 16; ++run) {
+    const ToolNodes& tool = run % 2 == 0 ? plate : spatula;
+    test_scene::SoftWorld world(true);
+    world.add_sphere();
+    for (int i = 0; i < 60; ++i) world.step_dynamics();
+    auto collision = make_paired_collision(tool, world.soft(), ThinBodyCollisionParams{});
+    CollisionStepResult result;
+    Eigen::Vector3d direction(unit(rng), unit(rng) - 1.2, unit(rng));  // mostly downward, never from below the ground
+    direction.normalize();
+    const double speed = std::pow(10.0, speed_log10(rng));
+    const Eigen::Vector3d spin = 5.0 * Eigen::Vector3d(unit(rng), unit(rng), unit(rng)) / std::sqrt(3.0);
+    ToolPose previous;
+    previous.orientation_world = Eigen::Quaterniond::UnitRandom();
+    previous.position_world_m = centre - 0.085 * direction + 0.02 * Eigen::Vector3d(unit(rng), 0.0, unit(rng));
+    test_scene::CrossingTracker tracker(tool, world.node_positions(), previous);
+    bool finite = true;
+    int contact_steps = 0;
+    const int steps = std::min(400, static_cast<int>(0.13 / (speed * kStep_s)) + 1);
+    for (int s = 0; s < steps; ++s) {
+      ToolPose current = previous;
+      current.position_world_m += speed * kStep_s * direction;
+      current.position_world_m.y() = std::max(current.position_world_m.y(), 0.025);  // stay off the ground
+      current.orientation_world =
+          (Eigen::Quaterniond(Eigen::AngleAxisd(spin.norm() * kStep_s, spin.normalized())) * previous.orientation_world).normalized();
+      world.step_dynamics();
+      collision->step(previous, current, kStep_s, world.soft(), result);
+      const auto nodes = world.node_positions();
+      tracker.update(nodes, current);
+      finite = finite && result.force_on_tool_world_n.allFinite();
+      for (const auto& p : nodes) finite = finite && p.allFinite();
+      contact_steps += result.contacted_triangles > 0 ? 1 : 0;
+      previous = current;
+    }
+    runs_with_contact += contact_steps > 0 ? 1 : 0;
+    EXPECT_EQ(tracker.crossed_nodes(), 0) << "run " << run << " speed " << speed;
+    EXPECT_LE(tracker.max_penetration_m(), 1e-4) << "run " << run << " speed " << speed;
+    EXPECT_TRUE(finite) << "run " << run;
+  }
+  EXPECT_GE(runs_with_contact, 12) << "the random runs must mostly hit the sphere";
 }
 
 TEST(PairedCollision, TwoRunsAreIdentical) {

@@ -27,28 +27,37 @@ constexpr double kBarycentricTolerance = 1e-7;
 
 struct Triangle {
   Eigen::Vector3d a, b, c, normal;
+  // Barycentric basis (edge vectors and their Gram determinant), precomputed once per triangle.
+  Eigen::Vector3d e0, e1;
+  double d00, d01, d11, inverse_denominator;
   bool valid;
 };
 
 Triangle make_triangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, double sign) {
-  const Eigen::Vector3d n = (b - a).cross(c - a);
+  Triangle t;
+  t.a = a;
+  t.b = b;
+  t.c = c;
+  t.e0 = b - a;
+  t.e1 = c - a;
+  const Eigen::Vector3d n = t.e0.cross(t.e1);
   const double length = n.norm();
-  return Triangle{a, b, c, length > 1e-18 ? Eigen::Vector3d(sign * n / length) : Eigen::Vector3d::Zero(), length > 1e-18};
+  t.d00 = t.e0.dot(t.e0);
+  t.d01 = t.e0.dot(t.e1);
+  t.d11 = t.e1.dot(t.e1);
+  const double denominator = t.d00 * t.d11 - t.d01 * t.d01;
+  t.valid = length > 1e-18 && denominator > 0.0;
+  t.normal = t.valid ? Eigen::Vector3d(sign * n / length) : Eigen::Vector3d::Zero();
+  t.inverse_denominator = t.valid ? 1.0 / denominator : 0.0;
+  return t;
 }
 
 bool projects_inside(const Triangle& t, const Eigen::Vector3d& p) {
-  const Eigen::Vector3d v0 = t.b - t.a;
-  const Eigen::Vector3d v1 = t.c - t.a;
   const Eigen::Vector3d v2 = p - t.a;
-  const double d00 = v0.dot(v0);
-  const double d01 = v0.dot(v1);
-  const double d11 = v1.dot(v1);
-  const double d20 = v2.dot(v0);
-  const double d21 = v2.dot(v1);
-  const double denominator = d00 * d11 - d01 * d01;
-  if (!(denominator > 0.0)) return false;
-  const double v = (d11 * d20 - d01 * d21) / denominator;
-  const double w = (d00 * d21 - d01 * d20) / denominator;
+  const double d20 = v2.dot(t.e0);
+  const double d21 = v2.dot(t.e1);
+  const double v = (t.d11 * d20 - t.d01 * d21) * t.inverse_denominator;
+  const double w = (t.d00 * d21 - t.d01 * d20) * t.inverse_denominator;
   return v >= -kBarycentricTolerance && w >= -kBarycentricTolerance && v + w <= 1.0 + kBarycentricTolerance;
 }
 
@@ -75,6 +84,11 @@ void sweep_tool_nodes(const CollisionModel& model, CollisionData& data) {
     Eigen::AlignedBox3d swept;
     swept.extend(start.a).extend(start.b).extend(start.c).extend(end.a).extend(end.b).extend(end.c);
     const double pad = contact + model.memory_depth_m;
+    // Faces whose swept bounds miss the tool's bounds (mostly along the thin axis) touch no node.
+    const Eigen::AlignedBox3d& tool_bounds = model.tool.bounds_tool_m();
+    if ((swept.min().array() > tool_bounds.max().array() + pad).any() ||
+        (swept.max().array() < tool_bounds.min().array() - pad).any())
+      continue;
     const int u0 = std::clamp(static_cast<int>(std::floor((swept.min()[bins.axis_u] - pad - bins.origin_u) / bins.cell_m)), 0, bins.cells_u - 1);
     const int u1 = std::clamp(static_cast<int>(std::floor((swept.max()[bins.axis_u] + pad - bins.origin_u) / bins.cell_m)), 0, bins.cells_u - 1);
     const int v0 = std::clamp(static_cast<int>(std::floor((swept.min()[bins.axis_v] - pad - bins.origin_v) / bins.cell_m)), 0, bins.cells_v - 1);
@@ -95,15 +109,23 @@ void sweep_tool_nodes(const CollisionModel& model, CollisionData& data) {
           const bool was_in_contact = data.node_face_prev[n] >= 0;
           if (s_start < -contact && !(was_in_contact && s_start >= -model.memory_depth_m)) continue;
           const double tau = s_start > contact ? (s_start - contact) / (s_start - s_end) : 1.0;
-          const Triangle at_tau = make_triangle(start.a + tau * (end.a - start.a), start.b + tau * (end.b - start.b),
-                                                start.c + tau * (end.c - start.c), sign);
-          if (!at_tau.valid || !projects_inside(at_tau, p)) continue;
+          bool inside = false;
+          Eigen::Vector3d normal_at_tau = end.normal;
+          if (tau >= 1.0) {
+            inside = projects_inside(end, p);
+          } else {
+            const Triangle at_tau = make_triangle(start.a + tau * (end.a - start.a), start.b + tau * (end.b - start.b),
+                                                  start.c + tau * (end.c - start.c), sign);
+            inside = at_tau.valid && projects_inside(at_tau, p);
+            normal_at_tau = at_tau.normal;
+          }
+          if (!inside) continue;
           const bool first = data.node_face[n] < 0;
           if (first || tau < data.node_tau[n] - 1e-12) {
             if (first) data.contact_nodes.push_back(node);
             data.node_face[n] = face;
             data.node_tau[n] = tau;
-            data.node_facing[n] = normals[n].dot(at_tau.normal);
+            data.node_facing[n] = normals[n].dot(normal_at_tau);
           }
         }
       }
