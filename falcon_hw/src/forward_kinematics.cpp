@@ -8,6 +8,7 @@
 // libnifalcon's fixed-gain scheme does from the origin.
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include <Eigen/LU>
 
@@ -38,16 +39,19 @@ FkResult failed_result() noexcept {
 
 FkResult newton(const FalconGeometry& geometry, const detail::ArmFrames& frames, const Eigen::Vector3d& theta_target,
                 Eigen::Vector3d& p, const FkOptions& options) noexcept {
-  if (!theta_target.allFinite()) return failed_result();
-  Eigen::Vector3d theta;
+  // IK only ever yields |θ1| < 90°, so a target outside that is unreachable; inside it the
+  // residual can be formed in tan(θ1/2) without an atan per evaluation (solve_residual).
+  if (!(theta_target.cwiseAbs().maxCoeff() < std::numbers::pi / 2.0)) return failed_result();
+  const Eigen::Vector3d tan_half_target{std::tan(0.5 * theta_target[0]), std::tan(0.5 * theta_target[1]),
+                                        std::tan(0.5 * theta_target[2])};
+  Eigen::Vector3d residual;
   Eigen::Matrix3d dtheta_dp;
-  if (!detail::solve_all(geometry, frames, p, theta, &dtheta_dp)) {
+  if (!detail::solve_residual(geometry, frames, p, tan_half_target, residual, dtheta_dp)) {
     // A start that is not reachable (first tick, after a fault) falls back to the centre.
     p = workspace_centre();
-    if (!detail::solve_all(geometry, frames, p, theta, &dtheta_dp)) return failed_result();
+    if (!detail::solve_residual(geometry, frames, p, tan_half_target, residual, dtheta_dp)) return failed_result();
   }
   FkResult result;
-  Eigen::Vector3d residual = theta - theta_target;
   double residual_norm_squared = residual.squaredNorm();
   result.residual_rad = max_abs(residual);
 
@@ -62,13 +66,11 @@ FkResult newton(const FalconGeometry& geometry, const detail::ArmFrames& frames,
     // Backtracking: accept the first fraction of the step that lowers ‖r‖₂ (the Newton
     // direction is a descent direction of ‖r‖₂², so a small enough fraction always does).
     bool accepted = false;
-    Eigen::Vector3d p_trial;
-    Eigen::Vector3d theta_trial;
-    Eigen::Matrix3d dtheta_dp_trial;
     for (int halving = 0; halving <= kMaxStepHalvings; ++halving) {
-      p_trial = p + step;
-      if (detail::solve_all(geometry, frames, p_trial, theta_trial, &dtheta_dp_trial)) {
-        const Eigen::Vector3d residual_trial = theta_trial - theta_target;
+      const Eigen::Vector3d p_trial = p + step;
+      Eigen::Vector3d residual_trial;
+      Eigen::Matrix3d dtheta_dp_trial;
+      if (detail::solve_residual(geometry, frames, p_trial, tan_half_target, residual_trial, dtheta_dp_trial)) {
         const double norm_squared_trial = residual_trial.squaredNorm();
         if (norm_squared_trial < residual_norm_squared) {
           p = p_trial;

@@ -18,7 +18,7 @@ bool arm_angles(const FalconGeometry& geometry, const Eigen::Vector3d& p_device_
     if (!detail::solve_arm(geometry, frames, i, p_device_m, solutions[i])) return false;
   }
   for (int i = 0; i < 3; ++i) {
-    arms[i].theta1_rad = solutions[i].theta1_rad;
+    arms[i].theta1_rad = 2.0 * std::atan(solutions[i].tan_half_theta1);
     arms[i].theta2_rad = std::atan2(solutions[i].sin2, solutions[i].cos2);
     arms[i].theta3_rad = std::atan2(solutions[i].sin3, solutions[i].cos3);
   }

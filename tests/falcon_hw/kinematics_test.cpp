@@ -8,6 +8,7 @@
 #include <string>
 #include <limits>
 #include <numbers>
+#include <random>
 
 #include <Eigen/LU>
 
@@ -323,6 +324,27 @@ TEST(ForwardKinematics, ToleranceAndIterationLimitAreHonoured) {
   EXPECT_FALSE(capped.converged);
   EXPECT_EQ(capped.iterations, 1);
   EXPECT_TRUE(solved.allFinite());
+}
+
+TEST(ForwardKinematics, ReportedResidualIsTheTrueAngleError) {
+  // FK forms its residual in tan(θ/2) with a series atan; it must equal IK(p) − θ exactly
+  // (to rounding) for residuals from 1e-12 to 1 rad. max_iterations = 0: no step taken.
+  std::mt19937_64 rng(24);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_int_distribution<int> decade(-12, 0);
+  for (const Eigen::Vector3d& p : sample_workspace(3000, 25, 0.9)) {
+    Eigen::Vector3d theta;
+    ASSERT_TRUE(inverse_kinematics(kGeometry, p, theta));
+    const Eigen::Vector3d offset = std::pow(10.0, decade(rng)) * Eigen::Vector3d{unit(rng), unit(rng), unit(rng)};
+    const Eigen::Vector3d target = theta + offset;
+    if (target.cwiseAbs().maxCoeff() >= 0.5 * std::numbers::pi) continue;
+    Eigen::Vector3d p_start = p;
+    const FkResult result = forward_kinematics(kGeometry, target, p_start, FkOptions{1e-300, 0});
+    EXPECT_EQ(result.iterations, 0);
+    EXPECT_EQ(p_start, p);
+    const double expected = offset.cwiseAbs().maxCoeff();
+    EXPECT_NEAR(result.residual_rad, expected, 1e-15 + 1e-13 * expected);
+  }
 }
 
 TEST(ForwardKinematics, UnreachableOrNonFiniteAnglesFailWithoutNan) {
