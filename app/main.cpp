@@ -9,6 +9,7 @@
 #include "commands.hpp"
 #include "device_kinematics.hpp"
 #include "device_usb.hpp"
+#include "sim_command.hpp"
 
 namespace {
 
@@ -49,6 +50,7 @@ int main(int argc, char** argv) {
   fissure::app::register_device_usb(tree);
   fissure::app::register_device_kinematics(tree);
   fissure::app::register_bench_kinematics(tree);
+  fissure::app::register_sim(tree);
 
   if (const std::string unknown = unknown_subcommand(root, argc, argv); !unknown.empty()) {
     std::fprintf(stderr, "fissure: error: %s (see 'fissure --help')\n", unknown.c_str());

@@ -1,0 +1,86 @@
+#pragma once
+// Method-independent contact metrics (BRIEF §9): crossed nodes and penetration into the
+// tool, measured from the soft nodes' positions and the tool's own geometry (built here
+// from the scene, NOT from the collision method's node model), so that every method is
+// judged by the same ruler.
+//
+// Definitions (tool frame; the thin axis is local y, the mid-plane is y = 0):
+// * footprint: the tool's silhouette seen along the thin axis (convex polygon in x–z).
+// * side memory: each soft node remembers the side of the mid-plane it is on (sign of
+//   y_tool). The memory follows the node freely while it is OUTSIDE the footprint (it may
+//   go around the rim); inside the footprint it is frozen.
+// * wrong side: the node is inside the footprint and on the other side of the mid-plane
+//   than it remembers — it went through the tool.
+// * inside: the node lies inside the tool volume deeper than kInsideToleranceM.
+// * crossed = wrong side OR inside (a node counts once). Target: 0 (issue 5).
+// * penetration: max(0, −signed distance to the tool volume); the max over nodes.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace fissure::host {
+
+/// A node deeper than this inside the tool counts as crossed. 0.1 mm is issue 5's target
+/// for the maximum penetration, so a node beyond it has failed the target outright.
+inline constexpr double kInsideToleranceM = 1e-4;
+
+/// The tool's convex volume for measurement, tool frame. Thin axis = local y.
+class ToolVolume {
+ public:
+  /// A box centred on the origin with these half extents (y the thinnest).
+  static ToolVolume from_box(const Eigen::Vector3d& half_extents_m);
+  /// A closed convex mesh (outward winding); planes are its triangles' planes.
+  static ToolVolume from_convex_mesh(const std::vector<Eigen::Vector3d>& vertices_m, const std::vector<std::array<int, 3>>& triangles);
+
+  /// max over planes of (n·p − d): exact depth (negative) inside, a lower bound outside.
+  [[nodiscard]] double signed_distance_m(const Eigen::Vector3d& p_tool) const noexcept;
+  /// Whether p_tool's projection along y falls inside the tool's silhouette.
+  [[nodiscard]] bool in_footprint(const Eigen::Vector3d& p_tool) const noexcept;
+  [[nodiscard]] double half_thickness_m() const noexcept { return half_thickness_m_; }
+
+ private:
+  struct Plane {
+    Eigen::Vector3d normal;
+    double offset_m;
+  };
+  struct Edge2d {  // a·(x, z) ≤ b inside
+    Eigen::Vector2d a;
+    double b;
+  };
+  std::vector<Plane> planes_;
+  std::vector<Edge2d> footprint_;
+  double half_thickness_m_ = 0.0;
+};
+
+/// What the metrics saw after one step, for one tool part (a jaw, or the whole spatula).
+struct CrossingSnapshot {
+  int crossed_nodes = 0;       ///< wrong side ∪ inside (see above)
+  int wrong_side_nodes = 0;
+  int inside_nodes = 0;
+  double max_penetration_m = 0.0;
+};
+
+/// Mutable per-node side memory for one rigid tool part; preallocated for the soft body's
+/// node count, then update() each step (no allocation).
+class CrossingTracker {
+ public:
+  CrossingTracker(ToolVolume volume, int soft_node_count);
+
+  /// Sets every node's side from its current position (call once before the tool moves in).
+  void reset(const std::vector<Eigen::Vector3d>& soft_nodes_world_m, const Eigen::Isometry3d& tool_to_world) noexcept;
+  /// Measures the nodes against the tool's current pose and updates the side memory.
+  CrossingSnapshot update(const std::vector<Eigen::Vector3d>& soft_nodes_world_m, const Eigen::Isometry3d& tool_to_world) noexcept;
+
+  [[nodiscard]] const ToolVolume& volume() const noexcept { return volume_; }
+  /// Per node: +1 / −1 remembered side, 0 not yet known (exactly on the mid-plane).
+  [[nodiscard]] const std::vector<std::int8_t>& sides() const noexcept { return side_; }
+
+ private:
+  ToolVolume volume_;
+  std::vector<std::int8_t> side_;
+};
+
+}  // namespace fissure::host

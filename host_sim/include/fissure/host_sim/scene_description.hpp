@@ -1,0 +1,159 @@
+#pragma once
+// A scene as loaded from its TOML file (docs/scenes.md): the const *model* of one host
+// simulation. Built once by load_scene() (or by hand in tests/benchmarks), never mutated
+// while a simulation runs. SI units everywhere; the unit is in every field name.
+//
+// Frames: *_world is the Bullet world (y up, ground top at ground.top_height_m). The tool
+// frame has its thin axis along local +y: a box tool is size_m = {width x, thickness y,
+// length z}; a convex mesh tool is authored with its thin direction along y; the clamp's
+// jaws face each other across local y.
+#include <array>
+#include <cstdint>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "fissure/shared/messages.hpp"
+#include "fissure/shared/session_config.hpp"
+
+namespace fissure::host {
+
+/// Which thin-body collision answers soft-vs-tool contact (BRIEF §3).
+enum class SceneCollisionMethod : std::uint8_t { kPaired, kRay, kBullet };
+
+[[nodiscard]] const char* to_string(SceneCollisionMethod method) noexcept;
+
+/// A rigid pose: position of the tool frame origin and its orientation, world frame.
+struct Pose {
+  Vec3 position_world_m{0.0, 0.0, 0.0};
+  Quat orientation_world{1.0, 0.0, 0.0, 0.0};  ///< unit quaternion (w, x, y, z)
+};
+
+/// Sphere tessellations: Bullet's own ellipsoid (convex hull of res+3 points: the paper's
+/// 128-face sphere is res 63) or a geodesic icosphere (20·4^k faces, near-uniform triangles,
+/// used for mesh convergence and scaling).
+enum class SphereTessellation : std::uint8_t { kBulletEllipsoid, kIcosphere };
+
+struct SoftSphere {
+  Vec3 center_world_m{0.0, 0.05, 0.0};
+  double radius_m = 0.05;
+  SphereTessellation tessellation = SphereTessellation::kBulletEllipsoid;
+  int faces_count = 128;
+};
+
+/// A closed cylinder (the paper's "vessel") lying with its axis along world x.
+struct SoftCylinder {
+  Vec3 center_world_m{0.0, 0.015, 0.0};
+  double radius_m = 0.015;
+  double length_m = 0.12;
+  int segments_count = 16;  ///< vertices around the circumference
+  int rings_count = 24;     ///< vertex rings along the axis (≥ 2)
+};
+
+/// A rectangular soft slab (closed box surface): flat top, bottom nodes pinned to the
+/// ground. The force–indentation benchmark's "flat contact set" specimen.
+struct SoftSlab {
+  Vec3 center_world_m{0.0, 0.01, 0.0};   ///< centre of the box
+  Vec3 size_m{0.08, 0.02, 0.08};         ///< full extents x, y (thickness), z
+  std::array<int, 2> top_cells_count{16, 16};  ///< grid cells of the top face along x, z
+};
+
+struct SoftBodyDescription {
+  std::variant<SoftSphere, SoftCylinder, SoftSlab> shape{SoftSphere{}};
+  double mass_kg = 0.1;
+  double linear_stiffness_ratio = 0.5;     ///< Bullet material kLST ∈ (0, 1]
+  double pressure_kpr = 0.0;               ///< Bullet config kPR (pressure coefficient), ≥ 0
+  double volume_conservation_kvc = 0.0;    ///< Bullet config kVC, ≥ 0
+  double damping_ratio = 0.01;             ///< Bullet config kDP ∈ [0, 1]
+  double friction_ratio = 0.2;             ///< Bullet config kDF ∈ [0, 1]
+  int position_iterations_count = 4;       ///< Bullet config piterations
+  double collision_margin_m = 0.002;       ///< soft body collision margin (bullet method)
+};
+
+struct GroundDescription {
+  double top_height_m = 0.0;               ///< world y of the ground's top face
+  Vec3 half_extents_m{0.5, 0.05, 0.5};     ///< box ground
+  double friction_ratio = 0.5;
+};
+
+enum class ToolKind : std::uint8_t { kBox, kConvexMesh, kClamp };
+
+/// Clamp: two box jaws facing each other across the tool's local y, centred at local
+/// y = ±(gap/2 + jaw thickness/2); a handle box that is drawn but never collides.
+struct ClampDescription {
+  Vec3 jaw_size_m{0.008, 0.003, 0.04};
+  Vec3 handle_size_m{0.006, 0.006, 0.12};
+  Vec3 handle_offset_tool_m{0.0, 0.0, -0.08};   ///< handle centre in the tool frame
+  double jaw_gap_open_m = 0.04;                 ///< gap between the jaws' inner faces when fully open
+  double jaw_gap_min_m = 0.0;                   ///< the jaws never close past this gap
+};
+
+struct ToolDescription {
+  ToolKind kind = ToolKind::kBox;
+  Vec3 box_size_m{0.04, 0.004, 0.04};      ///< box tool: full extents (x width, y thickness, z length)
+  std::string mesh_path;                   ///< convex mesh tool: absolute path of the OBJ (resolved at load)
+  std::vector<Vec3> mesh_vertices_tool_m;  ///< convex mesh tool: vertices, tool frame (loaded and checked at load)
+  std::vector<std::array<int, 3>> mesh_triangles;  ///< convex mesh tool: CCW seen from outside
+  ClampDescription clamp{};
+  double node_spacing_m = 0.004;           ///< box / clamp jaws: collision node grid spacing on the large faces
+  double pairing_ray_limit_m = 0.006;      ///< convex mesh: the pairing ray's length limit (paper Fig. 2); node per triangle
+};
+
+/// Hunt-Crossley F = k·xⁿ + λ·xⁿ·ẋ (BRIEF §4). per_unit_area (default): k, λ per m² of
+/// rest triangle area (mesh-independent); per_triangle: the paper's one force per triangle.
+enum class HuntCrossleyMode : std::uint8_t { kPerUnitArea, kPerTriangle };
+
+struct HuntCrossleyDescription {
+  HuntCrossleyMode mode = HuntCrossleyMode::kPerUnitArea;
+  double exponent_n = 1.5;
+  double stiffness_k = 0.0;   ///< per_unit_area: Pa/mⁿ = N/m⁽ⁿ⁺²⁾; per_triangle: N/mⁿ
+  double damping_lambda = 0.0;  ///< per_unit_area: Pa·s/m⁽ⁿ⁺¹⁾; per_triangle: N·s/m⁽ⁿ⁺¹⁾
+};
+
+struct SimulationDescription {
+  double time_step_s = 0.001;       ///< host step
+  int substeps_count = 1;           ///< Bullet internal steps per host step
+  Vec3 gravity_world_m_per_s2{0.0, -9.81, 0.0};
+  SceneCollisionMethod collision_method = SceneCollisionMethod::kPaired;
+};
+
+/// The scripted tool trajectory used by `fissure sim`: straight legs at constant speed; a
+/// clamp's jaw gap changes linearly over the leg, at most at the leg's speed.
+struct TrajectoryWaypoint {
+  Vec3 position_world_m{};
+  double speed_m_per_s = 0.05;
+  double hold_s = 0.0;
+  double jaw_gap_m = -1.0;          ///< clamp only: target jaw gap at the end of the leg; < 0 keeps the gap
+};
+
+struct TrajectoryDescription {
+  Pose start{};                     ///< the tool's pose at t = 0 (orientation kept throughout)
+  double start_jaw_gap_m = -1.0;    ///< clamp only: gap at t = 0; < 0 means fully open
+  std::vector<TrajectoryWaypoint> waypoints;
+};
+
+struct SceneDescription {
+  std::string name;                 ///< scene name (file stem)
+  std::string source_path;          ///< the file it came from ("" when built in code)
+  std::string description;
+  SimulationDescription simulation{};
+  GroundDescription ground{};
+  SoftBodyDescription soft_body{};
+  ToolDescription tool{};
+  HuntCrossleyDescription hunt_crossley{};
+  DeviceMapping device_mapping{};
+  HandScript hand{};
+  TrajectoryDescription trajectory{};
+};
+
+/// The tool pose and jaw gap the scripted trajectory prescribes at time t_s (piecewise
+/// linear legs, holds; after the last leg the tool stays put).
+struct TrajectorySample {
+  Pose pose{};
+  double jaw_gap_m = 0.0;
+};
+[[nodiscard]] TrajectorySample sample_trajectory(const SceneDescription& scene, double t_s) noexcept;
+/// Total scripted duration (all legs and holds) [s].
+[[nodiscard]] double trajectory_duration_s(const SceneDescription& scene) noexcept;
+
+}  // namespace fissure::host

@@ -1,0 +1,96 @@
+#pragma once
+// The Bullet world of a scene: btSoftRigidDynamicsWorld, box ground, the soft body, and the
+// tool's kinematic rigid bodies (one per collidable part: the spatula, or the clamp's two
+// jaws; the clamp handle never collides and has no body). The tool bodies collide with the
+// soft body through Bullet ONLY for the `bullet` method; for paired/ray they are not in the
+// world at all (thin_body_collision.hpp's call order) and the soft body meets just the ground.
+//
+// Bullet set-up shared by all methods (BRIEF §3): the sparse SDF's voxel is set to half the
+// tool's thinnest extent AFTER Initialize() (which forces 0.25 m), then Reset(); soft margin
+// from the scene; kKHR = kCHR = 1 (soft_body_builder).
+#include <array>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "fissure/host_sim/bullet_collision.hpp"
+#include "fissure/host_sim/scene_description.hpp"
+#include "fissure/host_sim/thin_tool.hpp"
+
+class btSoftRigidDynamicsWorld;
+class btSoftBody;
+class btRigidBody;
+class btCollisionShape;
+class btDefaultMotionState;
+class btBroadphaseInterface;
+class btCollisionDispatcher;
+class btSequentialImpulseConstraintSolver;
+class btSoftBodyRigidBodyCollisionConfiguration;
+
+namespace fissure::host {
+
+/// Half-extents of the tool's collidable parts in their own frames: the spatula box, the
+/// clamp's jaw box (both jaws), or the convex mesh's bounds. Part frames: thin axis local y.
+struct ToolPartGeometry {
+  int part_count = 1;
+  bool is_mesh = false;
+  Eigen::Vector3d box_half_extents_m = Eigen::Vector3d::Zero();  ///< box / jaw
+  double thickness_m = 0.0;                                      ///< thinnest extent (SDF voxel = half of it)
+};
+[[nodiscard]] ToolPartGeometry tool_part_geometry(const SceneDescription& scene);
+
+/// Pose of each collidable part for a tool pose and jaw gap (clamp: jaw A at local
+/// y = +(gap + jaw thickness)/2, jaw B at −(…); spatula: the tool pose itself).
+void tool_part_poses(const SceneDescription& scene, const ToolPose& tool, double jaw_gap_m, std::array<ToolPose, kMaxToolParts>& parts) noexcept;
+
+class SoftWorld {
+ public:
+  /// `tool_collides_in_bullet`: add the tool parts to the world (the `bullet` method) and,
+  /// unless `probe_contacts` is false (tests: the stock reference), measure their contacts
+  /// with a ContactProbeSolver; otherwise Bullet's default soft body solver.
+  SoftWorld(const SceneDescription& scene, bool tool_collides_in_bullet, bool probe_contacts = true);
+  ~SoftWorld();
+  SoftWorld(const SoftWorld&) = delete;
+  SoftWorld& operator=(const SoftWorld&) = delete;
+
+  [[nodiscard]] btSoftRigidDynamicsWorld& world() noexcept { return *world_; }
+  [[nodiscard]] btSoftBody& soft() noexcept { return *soft_; }
+  [[nodiscard]] const btSoftBody& soft() const noexcept { return *soft_; }
+  [[nodiscard]] int part_count() const noexcept { return geometry_.part_count; }
+  [[nodiscard]] const ToolPartGeometry& geometry() const noexcept { return geometry_; }
+  /// The part's rigid body (kinematic; in the world only when the tool collides in Bullet).
+  [[nodiscard]] const btRigidBody& part_body(int part) const noexcept { return *parts_[static_cast<std::size_t>(part)]; }
+  /// Non-null only when the tool collides in Bullet.
+  [[nodiscard]] ContactProbeSolver* probe() noexcept { return probe_; }
+  [[nodiscard]] double sdf_voxel_m() const noexcept { return sdf_voxel_m_; }
+
+  /// Places a tool part (kinematic: Bullet derives its velocity from the previous pose).
+  void set_part_pose(int part, const ToolPose& pose) noexcept;
+  /// One Bullet step of h seconds (exactly one internal substep).
+  void step(double h_s) noexcept;
+  /// Copies the soft nodes' positions (world, metres) into `out` (resized once).
+  void copy_node_positions(std::vector<Eigen::Vector3d>& out) const;
+
+ private:
+  ToolPartGeometry geometry_;
+  double sdf_voxel_m_ = 0.0;
+  std::unique_ptr<btSoftBodyRigidBodyCollisionConfiguration> configuration_;
+  std::unique_ptr<btCollisionDispatcher> dispatcher_;
+  std::unique_ptr<btBroadphaseInterface> broadphase_;
+  std::unique_ptr<btSequentialImpulseConstraintSolver> solver_;
+  std::unique_ptr<btDefaultSoftBodySolver> soft_solver_;
+  ContactProbeSolver* probe_ = nullptr;  // = soft_solver_ when probing
+  std::unique_ptr<btSoftRigidDynamicsWorld> world_;
+  std::vector<std::unique_ptr<btCollisionShape>> shapes_;
+  std::vector<std::unique_ptr<btDefaultMotionState>> motion_states_;
+  std::unique_ptr<btRigidBody> ground_;
+  std::array<std::unique_ptr<btRigidBody>, kMaxToolParts> parts_;
+  std::unique_ptr<btSoftBody> soft_;
+  bool parts_in_world_ = false;
+};
+
+[[nodiscard]] ToolPose to_tool_pose(const Pose& pose) noexcept;
+[[nodiscard]] Eigen::Isometry3d to_isometry(const ToolPose& pose) noexcept;
+
+}  // namespace fissure::host

@@ -1,0 +1,129 @@
+// Crossed nodes and penetration, independent of the collision method (contact_metrics.hpp).
+#include "fissure/host_sim/contact_metrics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <utility>
+
+namespace fissure::host {
+
+namespace {
+
+// 2-D convex hull (Andrew's monotone chain) of the x–z projection, counter-clockwise.
+std::vector<Eigen::Vector2d> hull_2d(std::vector<Eigen::Vector2d> points) {
+  std::sort(points.begin(), points.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return (a - o).x() * (b - o).y() - (a - o).y() * (b - o).x();
+  };
+  std::vector<Eigen::Vector2d> hull(2 * points.size());
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], points[i]) <= 0) --k;
+    hull[k++] = points[i];
+  }
+  for (std::size_t i = points.size() - 1, t = k + 1; i > 0; --i) {
+    while (k >= t && cross(hull[k - 2], hull[k - 1], points[i - 1]) <= 0) --k;
+    hull[k++] = points[i - 1];
+  }
+  hull.resize(k > 0 ? k - 1 : 0);
+  return hull;
+}
+
+}  // namespace
+
+ToolVolume ToolVolume::from_box(const Eigen::Vector3d& half_extents_m) {
+  if (!(half_extents_m.minCoeff() > 0.0)) throw std::invalid_argument("ToolVolume::from_box: half extents must be > 0");
+  ToolVolume v;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (double sign : {1.0, -1.0}) {
+      v.planes_.push_back({sign * Eigen::Vector3d::Unit(axis), half_extents_m[axis]});
+    }
+  }
+  const double hx = half_extents_m.x(), hz = half_extents_m.z();
+  v.footprint_ = {{{1, 0}, hx}, {{-1, 0}, hx}, {{0, 1}, hz}, {{0, -1}, hz}};
+  v.half_thickness_m_ = half_extents_m.y();
+  return v;
+}
+
+ToolVolume ToolVolume::from_convex_mesh(const std::vector<Eigen::Vector3d>& vertices_m, const std::vector<std::array<int, 3>>& triangles) {
+  if (vertices_m.size() < 4 || triangles.size() < 4) throw std::invalid_argument("ToolVolume::from_convex_mesh: too few vertices/triangles");
+  ToolVolume v;
+  for (const auto& t : triangles) {
+    const Eigen::Vector3d& a = vertices_m.at(static_cast<std::size_t>(t[0]));
+    const Eigen::Vector3d n = (vertices_m.at(static_cast<std::size_t>(t[1])) - a).cross(vertices_m.at(static_cast<std::size_t>(t[2])) - a);
+    if (n.norm() <= 0.0) continue;
+    const Eigen::Vector3d unit = n.normalized();
+    v.planes_.push_back({unit, unit.dot(a)});
+  }
+  std::vector<Eigen::Vector2d> projected;
+  double y_lo = std::numeric_limits<double>::infinity(), y_hi = -y_lo;
+  for (const Eigen::Vector3d& p : vertices_m) {
+    projected.emplace_back(p.x(), p.z());
+    y_lo = std::min(y_lo, p.y());
+    y_hi = std::max(y_hi, p.y());
+  }
+  const std::vector<Eigen::Vector2d> hull = hull_2d(projected);
+  for (std::size_t i = 0; i < hull.size(); ++i) {
+    const Eigen::Vector2d e = hull[(i + 1) % hull.size()] - hull[i];
+    const Eigen::Vector2d outward(e.y(), -e.x());  // CCW hull: right-hand normal points out
+    v.footprint_.push_back({outward, outward.dot(hull[i])});
+  }
+  v.half_thickness_m_ = 0.5 * (y_hi - y_lo);
+  return v;
+}
+
+double ToolVolume::signed_distance_m(const Eigen::Vector3d& p_tool) const noexcept {
+  double d = -std::numeric_limits<double>::infinity();
+  for (const Plane& plane : planes_) d = std::max(d, plane.normal.dot(p_tool) - plane.offset_m);
+  return d;
+}
+
+bool ToolVolume::in_footprint(const Eigen::Vector3d& p_tool) const noexcept {
+  const Eigen::Vector2d q(p_tool.x(), p_tool.z());
+  for (const Edge2d& e : footprint_) {
+    if (e.a.dot(q) > e.b) return false;
+  }
+  return true;
+}
+
+CrossingTracker::CrossingTracker(ToolVolume volume, int soft_node_count)
+    : volume_(std::move(volume)), side_(static_cast<std::size_t>(soft_node_count), 0) {}
+
+void CrossingTracker::reset(const std::vector<Eigen::Vector3d>& soft_nodes_world_m, const Eigen::Isometry3d& tool_to_world) noexcept {
+  const Eigen::Isometry3d world_to_tool = tool_to_world.inverse();
+  const std::size_t n = std::min(side_.size(), soft_nodes_world_m.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    const double y = (world_to_tool * soft_nodes_world_m[i]).y();
+    side_[i] = y > 0.0 ? 1 : (y < 0.0 ? -1 : 0);
+  }
+}
+
+CrossingSnapshot CrossingTracker::update(const std::vector<Eigen::Vector3d>& soft_nodes_world_m, const Eigen::Isometry3d& tool_to_world) noexcept {
+  CrossingSnapshot snap;
+  const Eigen::Isometry3d world_to_tool = tool_to_world.inverse();
+  const std::size_t n = std::min(side_.size(), soft_nodes_world_m.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d p = world_to_tool * soft_nodes_world_m[i];
+    const std::int8_t side_now = p.y() > 0.0 ? 1 : (p.y() < 0.0 ? -1 : 0);
+    const double penetration_m = std::max(0.0, -volume_.signed_distance_m(p));
+    snap.max_penetration_m = std::max(snap.max_penetration_m, penetration_m);
+    const bool inside = penetration_m > kInsideToleranceM;
+    bool wrong_side = false;
+    if (volume_.in_footprint(p)) {
+      if (side_[i] == 0) side_[i] = side_now;  // first seen exactly on the mid-plane
+      wrong_side = side_now != 0 && side_now != side_[i];
+    } else if (side_now != 0) {
+      side_[i] = side_now;  // outside the silhouette a node may go round the rim
+    }
+    snap.wrong_side_nodes += wrong_side ? 1 : 0;
+    snap.inside_nodes += inside ? 1 : 0;
+    snap.crossed_nodes += (wrong_side || inside) ? 1 : 0;
+  }
+  return snap;
+}
+
+}  // namespace fissure::host

@@ -1,0 +1,191 @@
+// One scene's host step: tool motion over sub-steps, Bullet, the collision method, metrics
+// (host_simulation.hpp).
+#include "fissure/host_sim/host_simulation.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include <BulletSoftBody/btSoftBody.h>
+#include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
+
+namespace fissure::host {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+int grid_nodes(double extent_m, double spacing_m) {
+  // Nodes at both edges and at most `spacing` apart.
+  return std::max(2, static_cast<int>(std::ceil(extent_m / spacing_m - 1e-9)) + 1);
+}
+
+ToolNodes build_tool_nodes(const SceneDescription& scene) {
+  const ToolDescription& tool = scene.tool;
+  if (tool.kind == ToolKind::kConvexMesh) {
+    ConvexMeshToolShape shape;
+    for (const Vec3& v : tool.mesh_vertices_tool_m) shape.vertices_tool_m.emplace_back(v[0], v[1], v[2]);
+    shape.triangles = tool.mesh_triangles;
+    shape.pairing_ray_limit_m = tool.pairing_ray_limit_m;
+    return ToolNodes::from_convex_mesh(shape);
+  }
+  const Vec3& size = tool.kind == ToolKind::kClamp ? tool.clamp.jaw_size_m : tool.box_size_m;
+  BoxToolShape shape;
+  shape.half_extents_m = 0.5 * Eigen::Vector3d(size[0], size[1], size[2]);
+  shape.thin_axis = 1;
+  shape.nodes_u = grid_nodes(size[0], tool.node_spacing_m);
+  shape.nodes_v = grid_nodes(size[2], tool.node_spacing_m);
+  return ToolNodes::from_box(shape);
+}
+
+ToolVolume build_volume(const SceneDescription& scene) {
+  const ToolDescription& tool = scene.tool;
+  if (tool.kind == ToolKind::kConvexMesh) {
+    std::vector<Eigen::Vector3d> vertices;
+    for (const Vec3& v : tool.mesh_vertices_tool_m) vertices.emplace_back(v[0], v[1], v[2]);
+    return ToolVolume::from_convex_mesh(vertices, tool.mesh_triangles);
+  }
+  const Vec3& size = tool.kind == ToolKind::kClamp ? tool.clamp.jaw_size_m : tool.box_size_m;
+  return ToolVolume::from_box(0.5 * Eigen::Vector3d(size[0], size[1], size[2]));
+}
+
+ToolPose interpolate(const ToolPose& a, const ToolPose& b, double s) {
+  ToolPose out;
+  out.position_world_m = a.position_world_m + s * (b.position_world_m - a.position_world_m);
+  out.orientation_world = a.orientation_world.slerp(s, b.orientation_world);
+  return out;
+}
+
+}  // namespace
+
+HostSimulation::HostSimulation(const SceneDescription& scene, std::optional<SceneCollisionMethod> method)
+    : scene_(scene), method_(method.value_or(scene.simulation.collision_method)) {
+  const bool bullet = method_ == SceneCollisionMethod::kBullet;
+  world_ = std::make_unique<SoftWorld>(scene_, bullet);
+  btSoftBody& soft = world_->soft();
+  const int parts = world_->part_count();
+  tool_pose_ = to_tool_pose(scene_.trajectory.start);
+  jaw_gap_m_ = scene_.trajectory.start_jaw_gap_m >= 0.0 ? scene_.trajectory.start_jaw_gap_m : scene_.tool.clamp.jaw_gap_open_m;
+  tool_part_poses(scene_, tool_pose_, jaw_gap_m_, part_poses_);
+  for (int p = 0; p < parts; ++p) {
+    if (bullet) {
+      collisions_[static_cast<std::size_t>(p)] = std::make_unique<BulletCollision>(*world_->probe(), world_->part_body(p), p);
+    } else {
+      tool_nodes_.push_back(build_tool_nodes(scene_));
+    }
+  }
+  if (!bullet) {
+    ThinBodyCollisionParams params;
+    params.hunt_crossley.k = scene_.hunt_crossley.stiffness_k;
+    params.hunt_crossley.lambda = scene_.hunt_crossley.damping_lambda;
+    params.hunt_crossley.n = scene_.hunt_crossley.exponent_n;
+    params.hunt_crossley.per_unit_area = scene_.hunt_crossley.mode == HuntCrossleyMode::kPerUnitArea;
+    for (int p = 0; p < parts; ++p) {
+      params.jaw = p;
+      const ToolNodes& nodes = tool_nodes_[static_cast<std::size_t>(p)];
+      collisions_[static_cast<std::size_t>(p)] = method_ == SceneCollisionMethod::kPaired ? make_paired_collision(nodes, soft, params)
+                                                                                          : make_ray_collision(nodes, soft, params);
+    }
+  }
+  const ToolVolume volume = build_volume(scene_);
+  for (int p = 0; p < parts; ++p) trackers_.emplace_back(volume, soft.m_nodes.size());
+  result_.part_count = parts;
+  result_.contacts.reserve(static_cast<std::size_t>(parts * std::max(soft.m_faces.size(), soft.m_nodes.size())));
+  for (auto& r : result_.part_results) r.reserve_for(std::max(soft.m_faces.size(), soft.m_nodes.size()));
+  for (int p = 0; p < parts; ++p) world_->set_part_pose(p, part_poses_[static_cast<std::size_t>(p)]);
+  world_->copy_node_positions(nodes_);
+  for (int p = 0; p < parts; ++p) trackers_[static_cast<std::size_t>(p)].reset(nodes_, to_isometry(part_poses_[static_cast<std::size_t>(p)]));
+}
+
+HostSimulation::~HostSimulation() = default;
+
+const ToolNodes* HostSimulation::tool_nodes(int part) const noexcept {
+  return static_cast<std::size_t>(part) < tool_nodes_.size() ? &tool_nodes_[static_cast<std::size_t>(part)] : nullptr;
+}
+
+Eigen::AlignedBox3d HostSimulation::soft_bounds_world_m() const noexcept {
+  Eigen::AlignedBox3d box;
+  for (const Eigen::Vector3d& p : nodes_) box.extend(p);
+  return box;
+}
+
+int HostSimulation::soft_face_count() const noexcept { return world_->soft().m_faces.size(); }
+int HostSimulation::soft_node_count() const noexcept { return world_->soft().m_nodes.size(); }
+
+TrajectorySample HostSimulation::scripted_target() const noexcept { return sample_trajectory(scene_, time_s_ + scene_.simulation.time_step_s); }
+
+void HostSimulation::settle(double seconds) {
+  const int steps = static_cast<int>(std::ceil(seconds / scene_.simulation.time_step_s));
+  for (int i = 0; i < steps; ++i) step(tool_pose_, jaw_gap_m_);
+  for (int p = 0; p < world_->part_count(); ++p) collisions_[static_cast<std::size_t>(p)]->reset_rest_state(world_->soft());
+  time_s_ = 0.0;  // the scripted trajectory starts after settling
+  world_->copy_node_positions(nodes_);
+  for (int p = 0; p < world_->part_count(); ++p) trackers_[static_cast<std::size_t>(p)].reset(nodes_, to_isometry(part_poses_[static_cast<std::size_t>(p)]));
+}
+
+const HostStepResult& HostSimulation::step(const ToolPose& tool_target, double jaw_gap_m) {
+  const Clock::time_point start = Clock::now();
+  const int parts = world_->part_count();
+  const int substeps = scene_.simulation.substeps_count;
+  const double h = scene_.simulation.time_step_s / substeps;
+  const bool clamp = scene_.tool.kind == ToolKind::kClamp;
+  const double gap_target = clamp ? std::clamp(jaw_gap_m, scene_.tool.clamp.jaw_gap_min_m, scene_.tool.clamp.jaw_gap_open_m) : 0.0;
+  const ToolPose from = tool_pose_;
+  const double gap_from = jaw_gap_m_;
+  result_.times = HostStepTimes{};
+  std::array<ToolPose, kMaxToolParts> previous = part_poses_;
+  for (int s = 1; s <= substeps; ++s) {
+    const double a = static_cast<double>(s) / substeps;
+    tool_pose_ = interpolate(from, tool_target, a);
+    jaw_gap_m_ = clamp ? gap_from + a * (gap_target - gap_from) : 0.0;
+    tool_part_poses(scene_, tool_pose_, jaw_gap_m_, part_poses_);
+    for (int p = 0; p < parts; ++p) world_->set_part_pose(p, part_poses_[static_cast<std::size_t>(p)]);
+    const Clock::time_point bullet_start = Clock::now();
+    world_->step(h);
+    result_.times.bullet_s += seconds_since(bullet_start);
+    for (int p = 0; p < parts; ++p) {
+      const auto k = static_cast<std::size_t>(p);
+      CollisionStepResult& r = result_.part_results[k];
+      const Clock::time_point collision_start = Clock::now();
+      collisions_[k]->step(previous[k], part_poses_[k], h, world_->soft(), r);
+      // bullet's collision ran inside stepSimulation (measured by the probe); ours runs here.
+      result_.times.collision_s += method_ == SceneCollisionMethod::kBullet ? r.seconds_narrow + r.seconds_response : seconds_since(collision_start);
+    }
+    previous = part_poses_;
+  }
+  time_s_ += scene_.simulation.time_step_s;
+  result_.time_s = time_s_;
+  result_.jaw_gap_m = jaw_gap_m_;
+  result_.force_on_tool_world_n.setZero();
+  result_.contacts.clear();
+  for (int p = 0; p < parts; ++p) {
+    const CollisionStepResult& r = result_.part_results[static_cast<std::size_t>(p)];
+    result_.part_force_world_n[static_cast<std::size_t>(p)] = r.force_on_tool_world_n;
+    result_.force_on_tool_world_n += r.force_on_tool_world_n;
+    for (const ContactRecord& c : r.contacts) {
+      if (result_.contacts.size() < result_.contacts.capacity()) result_.contacts.push_back(c);
+    }
+  }
+  result_.contact_count = static_cast<int>(result_.contacts.size());
+  result_.times.total_s = seconds_since(start);
+  const Clock::time_point metrics_start = Clock::now();
+  measure();
+  result_.times.metrics_s = seconds_since(metrics_start);
+  return result_;
+}
+
+void HostSimulation::measure() noexcept {
+  world_->copy_node_positions(nodes_);
+  result_.crossing = CrossingSnapshot{};
+  for (int p = 0; p < world_->part_count(); ++p) {
+    const CrossingSnapshot s = trackers_[static_cast<std::size_t>(p)].update(nodes_, to_isometry(part_poses_[static_cast<std::size_t>(p)]));
+    result_.crossing.crossed_nodes += s.crossed_nodes;
+    result_.crossing.wrong_side_nodes += s.wrong_side_nodes;
+    result_.crossing.inside_nodes += s.inside_nodes;
+    result_.crossing.max_penetration_m = std::max(result_.crossing.max_penetration_m, s.max_penetration_m);
+  }
+}
+
+}  // namespace fissure::host

@@ -1,0 +1,194 @@
+// Soft body meshes and their Bullet construction (soft_body_builder.hpp).
+#include "fissure/host_sim/soft_body_builder.hpp"
+
+#include <cmath>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include <BulletSoftBody/btSoftBody.h>
+#include <BulletSoftBody/btSoftBodyHelpers.h>
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace fissure::host {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+Eigen::Vector3d e3(const Vec3& v) { return {v[0], v[1], v[2]}; }
+
+// Every shape here is convex: orient each triangle so its normal points away from the
+// mesh's vertex centroid (the soft collisions take "outward" from the winding).
+void orient_outward(SurfaceMesh& mesh) {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const Vec3& v : mesh.vertices_m) centre += e3(v);
+  centre /= static_cast<double>(mesh.vertices_m.size());
+  for (auto& t : mesh.triangles) {
+    const Eigen::Vector3d a = e3(mesh.vertices_m[t[0]]), b = e3(mesh.vertices_m[t[1]]), c = e3(mesh.vertices_m[t[2]]);
+    if ((b - a).cross(c - a).dot((a + b + c) / 3.0 - centre) < 0.0) std::swap(t[1], t[2]);
+  }
+}
+
+}  // namespace
+
+SurfaceMesh make_icosphere(const Vec3& center_m, double radius_m, int subdivisions) {
+  const double phi = (1.0 + std::sqrt(5.0)) / 2.0;
+  std::vector<Eigen::Vector3d> v = {{-1, phi, 0}, {1, phi, 0}, {-1, -phi, 0}, {1, -phi, 0}, {0, -1, phi}, {0, 1, phi},
+                                    {0, -1, -phi}, {0, 1, -phi}, {phi, 0, -1}, {phi, 0, 1}, {-phi, 0, -1}, {-phi, 0, 1}};
+  for (auto& p : v) p.normalize();
+  std::vector<std::array<int, 3>> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                                       {11, 10, 2}, {10, 7, 6}, {7, 1, 8},   {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+                                       {3, 8, 9},  {4, 9, 5},  {2, 4, 11},  {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+  for (int s = 0; s < subdivisions; ++s) {
+    std::map<std::pair<int, int>, int> midpoint;
+    auto mid = [&](int a, int b) {
+      const auto key = std::minmax(a, b);
+      const auto it = midpoint.find(key);
+      if (it != midpoint.end()) return it->second;
+      v.push_back((v[static_cast<std::size_t>(a)] + v[static_cast<std::size_t>(b)]).normalized());
+      const int index = static_cast<int>(v.size()) - 1;
+      midpoint.emplace(key, index);
+      return index;
+    };
+    std::vector<std::array<int, 3>> next;
+    next.reserve(f.size() * 4);
+    for (const auto& t : f) {
+      const int ab = mid(t[0], t[1]), bc = mid(t[1], t[2]), ca = mid(t[2], t[0]);
+      next.push_back({t[0], ab, ca});
+      next.push_back({t[1], bc, ab});
+      next.push_back({t[2], ca, bc});
+      next.push_back({ab, bc, ca});
+    }
+    f = std::move(next);
+  }
+  SurfaceMesh mesh;
+  for (const auto& p : v) mesh.vertices_m.push_back({center_m[0] + radius_m * p.x(), center_m[1] + radius_m * p.y(), center_m[2] + radius_m * p.z()});
+  mesh.triangles = std::move(f);
+  orient_outward(mesh);
+  return mesh;
+}
+
+SurfaceMesh make_cylinder(const SoftCylinder& c) {
+  SurfaceMesh mesh;
+  const int n = c.segments_count, rings = c.rings_count;
+  for (int k = 0; k < rings; ++k) {
+    const double x = c.center_world_m[0] - 0.5 * c.length_m + c.length_m * k / (rings - 1);
+    for (int j = 0; j < n; ++j) {
+      const double angle = 2.0 * kPi * j / n;
+      mesh.vertices_m.push_back({x, c.center_world_m[1] + c.radius_m * std::cos(angle), c.center_world_m[2] + c.radius_m * std::sin(angle)});
+    }
+  }
+  for (int k = 0; k + 1 < rings; ++k) {
+    for (int j = 0; j < n; ++j) {
+      const int a = k * n + j, b = k * n + (j + 1) % n, cc = (k + 1) * n + (j + 1) % n, d = (k + 1) * n + j;
+      mesh.triangles.push_back({a, b, cc});
+      mesh.triangles.push_back({a, cc, d});
+    }
+  }
+  for (int end = 0; end < 2; ++end) {
+    const int centre = static_cast<int>(mesh.vertices_m.size());
+    const double x = c.center_world_m[0] + (end == 0 ? -0.5 : 0.5) * c.length_m;
+    mesh.vertices_m.push_back({x, c.center_world_m[1], c.center_world_m[2]});
+    const int ring = end == 0 ? 0 : rings - 1;
+    for (int j = 0; j < n; ++j) mesh.triangles.push_back({centre, ring * n + j, ring * n + (j + 1) % n});
+  }
+  orient_outward(mesh);
+  return mesh;
+}
+
+SurfaceMesh make_slab(const SoftSlab& s) {
+  SurfaceMesh mesh;
+  const int nx = s.top_cells_count[0], nz = s.top_cells_count[1];
+  const int per_face = (nx + 1) * (nz + 1);
+  for (int face = 0; face < 2; ++face) {  // 0 = top, 1 = bottom
+    const double y = s.center_world_m[1] + (face == 0 ? 0.5 : -0.5) * s.size_m[1];
+    for (int i = 0; i <= nx; ++i) {
+      for (int j = 0; j <= nz; ++j) {
+        mesh.vertices_m.push_back({s.center_world_m[0] - 0.5 * s.size_m[0] + s.size_m[0] * i / nx, y,
+                                   s.center_world_m[2] - 0.5 * s.size_m[2] + s.size_m[2] * j / nz});
+        if (face == 1) mesh.pinned_vertices.push_back(static_cast<int>(mesh.vertices_m.size()) - 1);
+      }
+    }
+  }
+  auto index = [&](int face, int i, int j) { return face * per_face + i * (nz + 1) + j; };
+  for (int face = 0; face < 2; ++face) {
+    for (int i = 0; i < nx; ++i) {
+      for (int j = 0; j < nz; ++j) {
+        mesh.triangles.push_back({index(face, i, j), index(face, i + 1, j), index(face, i + 1, j + 1)});
+        mesh.triangles.push_back({index(face, i, j), index(face, i + 1, j + 1), index(face, i, j + 1)});
+      }
+    }
+  }
+  // Side walls: one quad row joining the top and bottom grids' boundary loops.
+  std::vector<std::pair<int, int>> loop;
+  for (int i = 0; i < nx; ++i) loop.emplace_back(i, 0);
+  for (int j = 0; j < nz; ++j) loop.emplace_back(nx, j);
+  for (int i = nx; i > 0; --i) loop.emplace_back(i, nz);
+  for (int j = nz; j > 0; --j) loop.emplace_back(0, j);
+  for (std::size_t k = 0; k < loop.size(); ++k) {
+    const auto [i0, j0] = loop[k];
+    const auto [i1, j1] = loop[(k + 1) % loop.size()];
+    mesh.triangles.push_back({index(0, i0, j0), index(0, i1, j1), index(1, i1, j1)});
+    mesh.triangles.push_back({index(0, i0, j0), index(1, i1, j1), index(1, i0, j0)});
+  }
+  orient_outward(mesh);
+  return mesh;
+}
+
+btSoftBody* build_soft_body(btSoftBodyWorldInfo& world_info, const SoftBodyDescription& d) {
+  btSoftBody* body = nullptr;
+  std::vector<int> pinned;
+  if (const auto* sphere = std::get_if<SoftSphere>(&d.shape); sphere != nullptr && sphere->tessellation == SphereTessellation::kBulletEllipsoid) {
+    // CreateEllipsoid builds the convex hull of res + 3 points: 2·(res + 3) − 4 faces.
+    const int res = (sphere->faces_count - 2) / 2;
+    body = btSoftBodyHelpers::CreateEllipsoid(world_info, btVector3(static_cast<btScalar>(sphere->center_world_m[0]), static_cast<btScalar>(sphere->center_world_m[1]), static_cast<btScalar>(sphere->center_world_m[2])),
+                                              btVector3(1, 1, 1) * static_cast<btScalar>(sphere->radius_m), res);
+    if (body->m_faces.size() != sphere->faces_count) {
+      const int got = body->m_faces.size();
+      delete body;
+      throw std::runtime_error("CreateEllipsoid gave " + std::to_string(got) + " faces, not the requested " + std::to_string(sphere->faces_count));
+    }
+  } else {
+    SurfaceMesh mesh;
+    if (const auto* ico = std::get_if<SoftSphere>(&d.shape)) {
+      int subdivisions = 0;
+      for (int faces = 20; faces < ico->faces_count; faces *= 4) ++subdivisions;
+      mesh = make_icosphere(ico->center_world_m, ico->radius_m, subdivisions);
+    } else if (const auto* cylinder = std::get_if<SoftCylinder>(&d.shape)) {
+      mesh = make_cylinder(*cylinder);
+    } else {
+      mesh = make_slab(std::get<SoftSlab>(d.shape));
+    }
+    std::vector<btScalar> xyz;
+    xyz.reserve(mesh.vertices_m.size() * 3);
+    for (const Vec3& v : mesh.vertices_m) {
+      for (double c : v) xyz.push_back(static_cast<btScalar>(c));
+    }
+    std::vector<int> tris;
+    tris.reserve(mesh.triangles.size() * 3);
+    for (const auto& t : mesh.triangles) tris.insert(tris.end(), t.begin(), t.end());
+    body = btSoftBodyHelpers::CreateFromTriMesh(world_info, xyz.data(), tris.data(), static_cast<int>(mesh.triangles.size()), true);
+    pinned = mesh.pinned_vertices;
+  }
+  body->m_materials[0]->m_kLST = static_cast<btScalar>(d.linear_stiffness_ratio);
+  body->m_cfg.kPR = static_cast<btScalar>(d.pressure_kpr);
+  body->m_cfg.kVC = static_cast<btScalar>(d.volume_conservation_kvc);
+  body->m_cfg.kDP = static_cast<btScalar>(d.damping_ratio);
+  body->m_cfg.kDF = static_cast<btScalar>(d.friction_ratio);
+  body->m_cfg.piterations = d.position_iterations_count;
+  // Contact hardness 1 for static/kinematic (kKHR) and dynamic (kCHR) rigid contacts: the
+  // "fair" Bullet baseline (BRIEF §3; the default 0.1 lets nodes leak even at 0.1 m/s).
+  body->m_cfg.kKHR = 1;
+  body->m_cfg.kCHR = 1;
+  body->getCollisionShape()->setMargin(static_cast<btScalar>(d.collision_margin_m));
+  body->setTotalMass(static_cast<btScalar>(d.mass_kg), false);
+  for (int i : pinned) body->setMass(i, 0);
+  if (d.volume_conservation_kvc > 0.0) body->setPose(true, false);
+  body->setActivationState(DISABLE_DEACTIVATION);
+  return body;
+}
+
+}  // namespace fissure::host

@@ -1,0 +1,216 @@
+// The Bullet world of a scene (soft_world.hpp).
+#include "fissure/host_sim/soft_world.hpp"
+
+#include <algorithm>
+
+#include <Eigen/Geometry>
+
+#include <BulletCollision/CollisionShapes/btBoxShape.h>
+#include <BulletCollision/CollisionShapes/btConvexHullShape.h>
+#include <BulletDynamics/ConstraintSolver/btSequentialImpulseConstraintSolver.h>
+#include <BulletSoftBody/btSoftBody.h>
+#include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
+#include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
+#include <btBulletDynamicsCommon.h>
+
+#include "fissure/host_sim/soft_body_builder.hpp"
+
+namespace fissure::host {
+
+namespace {
+
+// The tool's Bullet shape margin, as a fraction of its half thickness. Measured here: with a
+// small margin, btGjkEpaSolver2::SignedDistance (which fills btSparseSdf's voxels) returns
+// POSITIVE distances for points inside a thin box away from its centre (GJK reports
+// "separated"), so Bullet's SDF reads +0.5…1 mm inside a 4 mm plate and never pushes an
+// entered node out — it leaks even at 0.1 m/s. With a margin close to the half thickness
+// the shape is a thin core + margin and GJK's distances are right (negative) inside. The
+// fair baseline therefore uses 0.9 × half thickness: the box keeps its outer size (its
+// edges round off, like the convex spatula's rim).
+constexpr double kToolShapeMarginRatio = 0.9;
+
+btVector3 bt(const Vec3& v) { return {static_cast<btScalar>(v[0]), static_cast<btScalar>(v[1]), static_cast<btScalar>(v[2])}; }
+btVector3 bt(const Eigen::Vector3d& v) { return {static_cast<btScalar>(v.x()), static_cast<btScalar>(v.y()), static_cast<btScalar>(v.z())}; }
+
+btTransform bt(const ToolPose& pose) {
+  const Eigen::Quaterniond& q = pose.orientation_world;
+  return btTransform(btQuaternion(static_cast<btScalar>(q.x()), static_cast<btScalar>(q.y()), static_cast<btScalar>(q.z()), static_cast<btScalar>(q.w())),
+                     bt(pose.position_world_m));
+}
+
+}  // namespace
+
+ToolPose to_tool_pose(const Pose& pose) noexcept {
+  ToolPose out;
+  out.position_world_m = Eigen::Vector3d(pose.position_world_m[0], pose.position_world_m[1], pose.position_world_m[2]);
+  out.orientation_world = Eigen::Quaterniond(pose.orientation_world[0], pose.orientation_world[1], pose.orientation_world[2], pose.orientation_world[3]).normalized();
+  return out;
+}
+
+Eigen::Isometry3d to_isometry(const ToolPose& pose) noexcept {
+  Eigen::Isometry3d iso = Eigen::Isometry3d::Identity();
+  iso.linear() = pose.orientation_world.toRotationMatrix();
+  iso.translation() = pose.position_world_m;
+  return iso;
+}
+
+ToolPartGeometry tool_part_geometry(const SceneDescription& scene) {
+  ToolPartGeometry g;
+  switch (scene.tool.kind) {
+    case ToolKind::kBox:
+      g.box_half_extents_m = 0.5 * Eigen::Vector3d(scene.tool.box_size_m[0], scene.tool.box_size_m[1], scene.tool.box_size_m[2]);
+      g.thickness_m = scene.tool.box_size_m[1];
+      break;
+    case ToolKind::kClamp:
+      g.part_count = 2;
+      g.box_half_extents_m = 0.5 * Eigen::Vector3d(scene.tool.clamp.jaw_size_m[0], scene.tool.clamp.jaw_size_m[1], scene.tool.clamp.jaw_size_m[2]);
+      g.thickness_m = scene.tool.clamp.jaw_size_m[1];
+      break;
+    case ToolKind::kConvexMesh: {
+      g.is_mesh = true;
+      double lo = 1e300, hi = -1e300;
+      for (const Vec3& v : scene.tool.mesh_vertices_tool_m) {
+        lo = std::min(lo, v[1]);
+        hi = std::max(hi, v[1]);
+      }
+      g.thickness_m = hi - lo;
+      break;
+    }
+  }
+  return g;
+}
+
+void tool_part_poses(const SceneDescription& scene, const ToolPose& tool, double jaw_gap_m, std::array<ToolPose, kMaxToolParts>& parts) noexcept {
+  if (scene.tool.kind != ToolKind::kClamp) {
+    parts[0] = tool;
+    parts[1] = tool;
+    return;
+  }
+  const double gap_m = std::clamp(jaw_gap_m, scene.tool.clamp.jaw_gap_min_m, scene.tool.clamp.jaw_gap_open_m);
+  const double offset_m = 0.5 * (gap_m + scene.tool.clamp.jaw_size_m[1]);
+  for (int p = 0; p < 2; ++p) {
+    ToolPose& part = parts[static_cast<std::size_t>(p)];
+    part.orientation_world = tool.orientation_world;
+    part.position_world_m = tool.to_world(Eigen::Vector3d(0.0, p == 0 ? offset_m : -offset_m, 0.0));
+  }
+}
+
+SoftWorld::SoftWorld(const SceneDescription& scene, bool tool_collides_in_bullet, bool probe_contacts)
+    : geometry_(tool_part_geometry(scene)), parts_in_world_(tool_collides_in_bullet) {
+  configuration_ = std::make_unique<btSoftBodyRigidBodyCollisionConfiguration>();
+  dispatcher_ = std::make_unique<btCollisionDispatcher>(configuration_.get());
+  broadphase_ = std::make_unique<btDbvtBroadphase>();
+  solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
+  if (tool_collides_in_bullet && probe_contacts) {
+    auto probe = std::make_unique<ContactProbeSolver>();
+    probe_ = probe.get();
+    soft_solver_ = std::move(probe);
+  } else {
+    soft_solver_ = std::make_unique<btDefaultSoftBodySolver>();
+  }
+  world_ = std::make_unique<btSoftRigidDynamicsWorld>(dispatcher_.get(), broadphase_.get(), solver_.get(), configuration_.get(), soft_solver_.get());
+  const btVector3 gravity = bt(scene.simulation.gravity_world_m_per_s2);
+  world_->setGravity(gravity);
+  btSoftBodyWorldInfo& info = world_->getWorldInfo();
+  info.m_gravity = gravity;
+  info.m_dispatcher = dispatcher_.get();
+  info.m_broadphase = broadphase_.get();
+  // Initialize() forces a 0.25 m voxel; the fair baseline needs ~half the tool thickness.
+  sdf_voxel_m_ = 0.5 * geometry_.thickness_m;
+  info.m_sparsesdf.Initialize();
+  info.m_sparsesdf.setDefaultVoxelsz(static_cast<btScalar>(sdf_voxel_m_));
+  info.m_sparsesdf.Reset();
+
+  // Ground: a static box whose top face is at ground.top_height_m.
+  const GroundDescription& g = scene.ground;
+  shapes_.push_back(std::make_unique<btBoxShape>(bt(g.half_extents_m)));
+  btTransform ground_pose = btTransform::getIdentity();
+  ground_pose.setOrigin(btVector3(0, static_cast<btScalar>(g.top_height_m - g.half_extents_m[1]), 0));
+  motion_states_.push_back(std::make_unique<btDefaultMotionState>(ground_pose));
+  ground_ = std::make_unique<btRigidBody>(btRigidBody::btRigidBodyConstructionInfo(0, motion_states_.back().get(), shapes_.back().get()));
+  ground_->setFriction(static_cast<btScalar>(g.friction_ratio));
+  world_->addRigidBody(ground_.get());
+
+  // Tool parts: kinematic bodies (the tool is driven, never pushed).
+  for (int p = 0; p < geometry_.part_count; ++p) {
+    const double margin_m = kToolShapeMarginRatio * 0.5 * geometry_.thickness_m;
+    if (geometry_.is_mesh) {
+      // btConvexHullShape adds its margin OUTSIDE the hull: give it the mesh's core, the
+      // mesh shrunk by the margin (y flattened, x and z pulled in), so core + margin ≈ mesh.
+      Eigen::AlignedBox3d bounds;
+      for (const Vec3& v : scene.tool.mesh_vertices_tool_m) bounds.extend(Eigen::Vector3d(v[0], v[1], v[2]));
+      const Eigen::Vector3d half = 0.5 * bounds.sizes(), centre = bounds.center();
+      const Eigen::Vector3d scale(1.0 - margin_m / half.x(), 1.0 - margin_m / half.y(), 1.0 - margin_m / half.z());
+      auto hull = std::make_unique<btConvexHullShape>();
+      for (const Vec3& v : scene.tool.mesh_vertices_tool_m) {
+        hull->addPoint(bt(Eigen::Vector3d(centre + scale.cwiseProduct(Eigen::Vector3d(v[0], v[1], v[2]) - centre))), false);
+      }
+      hull->recalcLocalAabb();
+      hull->setMargin(static_cast<btScalar>(margin_m));
+      shapes_.push_back(std::move(hull));
+    } else {
+      auto box = std::make_unique<btBoxShape>(bt(geometry_.box_half_extents_m));
+      box->setMargin(static_cast<btScalar>(margin_m));  // keeps the outer size
+      shapes_.push_back(std::move(box));
+    }
+    motion_states_.push_back(std::make_unique<btDefaultMotionState>(btTransform::getIdentity()));
+    auto body = std::make_unique<btRigidBody>(btRigidBody::btRigidBodyConstructionInfo(0, motion_states_.back().get(), shapes_.back().get()));
+    body->setCollisionFlags(body->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
+    body->setActivationState(DISABLE_DEACTIVATION);
+    body->setFriction(0);
+    parts_[static_cast<std::size_t>(p)] = std::move(body);
+  }
+  std::array<ToolPose, kMaxToolParts> start{};
+  tool_part_poses(scene, to_tool_pose(scene.trajectory.start), scene.trajectory.start_jaw_gap_m >= 0.0 ? scene.trajectory.start_jaw_gap_m : scene.tool.clamp.jaw_gap_open_m, start);
+  for (int p = 0; p < geometry_.part_count; ++p) {
+    btRigidBody& body = *parts_[static_cast<std::size_t>(p)];
+    body.setWorldTransform(bt(start[static_cast<std::size_t>(p)]));
+    body.getMotionState()->setWorldTransform(bt(start[static_cast<std::size_t>(p)]));
+    body.setInterpolationWorldTransform(bt(start[static_cast<std::size_t>(p)]));
+    if (parts_in_world_) world_->addRigidBody(&body);
+  }
+
+  soft_.reset(build_soft_body(info, scene.soft_body));
+  world_->addSoftBody(soft_.get());
+  if (probe_ != nullptr) {
+    std::array<const btCollisionObject*, kMaxToolParts> objects{};
+    for (int p = 0; p < geometry_.part_count; ++p) objects[static_cast<std::size_t>(p)] = parts_[static_cast<std::size_t>(p)].get();
+    probe_->attach(soft_.get(), objects);
+  }
+}
+
+SoftWorld::~SoftWorld() {
+  if (world_) {
+    world_->removeSoftBody(soft_.get());
+    for (int p = 0; p < geometry_.part_count; ++p) {
+      if (parts_in_world_) world_->removeRigidBody(parts_[static_cast<std::size_t>(p)].get());
+    }
+    world_->removeRigidBody(ground_.get());
+  }
+}
+
+void SoftWorld::set_part_pose(int part, const ToolPose& pose) noexcept {
+  btRigidBody& body = *parts_[static_cast<std::size_t>(part)];
+  body.getMotionState()->setWorldTransform(bt(pose));
+  if (!parts_in_world_) body.setWorldTransform(bt(pose));  // not stepped by the world
+}
+
+void SoftWorld::step(double h_s) noexcept {
+  if (probe_ != nullptr) probe_->clear();
+  const auto h = static_cast<btScalar>(h_s);
+  world_->stepSimulation(h, 1, h);
+  // The sparse SDF caches cells per shape; drop the ones not used for a while (as Bullet's
+  // demos do every frame) so a long run does not hit the cell cap and reset.
+  world_->getWorldInfo().m_sparsesdf.GarbageCollect();
+}
+
+void SoftWorld::copy_node_positions(std::vector<Eigen::Vector3d>& out) const {
+  const int n = soft_->m_nodes.size();
+  out.resize(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const btVector3& x = soft_->m_nodes[i].m_x;
+    out[static_cast<std::size_t>(i)] = Eigen::Vector3d(x.x(), x.y(), x.z());
+  }
+}
+
+}  // namespace fissure::host

@@ -1,0 +1,195 @@
+// Scene files: every shipped scene loads; every kind of malformed file is refused with an
+// error naming file, line and field; the scripted trajectory is sampled as documented.
+#include "fissure/host_sim/scene_loader.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace fissure::host {
+namespace {
+
+// Tests run in the source tree (fissure_add_test's WORKING_DIRECTORY).
+const std::filesystem::path kScenes = "scenes";
+
+std::string read(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// 1-based line of the first occurrence of `needle` in `text`.
+int line_of(const std::string& text, const std::string& needle) {
+  const std::size_t at = text.find(needle);
+  EXPECT_NE(at, std::string::npos) << needle;
+  int line = 1;
+  for (std::size_t i = 0; i < at; ++i) line += text[i] == '\n' ? 1 : 0;
+  return line;
+}
+
+std::string replace(std::string text, const std::string& from, const std::string& to) {
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+// Loads `text` and returns the SceneError (fails the test when it loads).
+SceneError load_error(const std::string& text) {
+  try {
+    (void)load_scene_text(text, "bad.toml", kScenes);
+  } catch (const SceneError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "the malformed scene loaded";
+  return SceneError("", 0, "", "");
+}
+
+void expect_error(const SceneError& e, int line, const std::string& field, const std::string& message_part) {
+  EXPECT_EQ(e.file(), "bad.toml");
+  EXPECT_EQ(e.line(), line) << e.what();
+  EXPECT_EQ(e.field(), field) << e.what();
+  EXPECT_NE(std::string(e.what()).find("bad.toml:" + std::to_string(line) + ":"), std::string::npos) << e.what();
+  EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+  EXPECT_NE(std::string(e.what()).find(message_part), std::string::npos) << e.what();
+}
+
+TEST(SceneLoader, EveryShippedSceneLoads) {
+  int count = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(kScenes)) {
+    if (entry.path().extension() != ".toml") continue;
+    SCOPED_TRACE(entry.path().string());
+    const SceneDescription scene = load_scene(entry.path());
+    EXPECT_EQ(scene.name, entry.path().stem().string());
+    EXPECT_FALSE(scene.description.empty());
+    EXPECT_FALSE(scene.trajectory.waypoints.empty());
+    EXPECT_GT(trajectory_duration_s(scene), 0.0);
+    ++count;
+  }
+  EXPECT_GE(count, 4);
+}
+
+TEST(SceneLoader, PaperScenesHaveTheirShapes) {
+  const SceneDescription spatula = load_scene(resolve_scene_path("spatula-sphere"));
+  EXPECT_EQ(spatula.tool.kind, ToolKind::kBox);
+  ASSERT_TRUE(std::holds_alternative<SoftSphere>(spatula.soft_body.shape));
+  EXPECT_EQ(std::get<SoftSphere>(spatula.soft_body.shape).faces_count, 128);
+  EXPECT_DOUBLE_EQ(std::get<SoftSphere>(spatula.soft_body.shape).radius_m, 0.05);
+  EXPECT_EQ(spatula.simulation.collision_method, SceneCollisionMethod::kPaired);
+  EXPECT_FALSE(spatula.device_mapping.clamp_mode);
+  EXPECT_EQ(spatula.hand.waypoints.size(), 2u);
+
+  const SceneDescription convex = load_scene(resolve_scene_path("convex-spatula-sphere"));
+  EXPECT_EQ(convex.tool.kind, ToolKind::kConvexMesh);
+  EXPECT_GT(convex.tool.mesh_triangles.size(), 100u);
+  EXPECT_DOUBLE_EQ(convex.tool.pairing_ray_limit_m, 0.003);
+
+  const SceneDescription clamp = load_scene(resolve_scene_path("clamp-sphere.toml"));
+  EXPECT_EQ(clamp.tool.kind, ToolKind::kClamp);
+  EXPECT_TRUE(clamp.device_mapping.clamp_mode);
+  EXPECT_EQ(clamp.device_mapping.closing_axis_world, 2);
+
+  const SceneDescription vessel = load_scene(resolve_scene_path("clamp-vessel"));
+  EXPECT_TRUE(std::holds_alternative<SoftCylinder>(vessel.soft_body.shape));
+}
+
+TEST(SceneLoader, UnknownKeyNamesFileLineAndField) {
+  const std::string good = read(kScenes / "spatula-sphere.toml");
+  const std::string bad = replace(good, "mass_kg = 0.1\n", "mass_kg = 0.1\ncolour = \"red\"\n");
+  expect_error(load_error(bad), line_of(bad, "colour"), "soft_body.colour", "unknown key");
+}
+
+TEST(SceneLoader, MissingFieldNamesItsTable) {
+  const std::string good = read(kScenes / "spatula-sphere.toml");
+  const std::string bad = replace(good, "mass_kg = 0.1\n", "");
+  expect_error(load_error(bad), line_of(bad, "[soft_body]"), "soft_body.mass_kg", "missing field");
+}
+
+TEST(SceneLoader, MissingTableIsNamed) {
+  const std::string good = read(kScenes / "spatula-sphere.toml");
+  const std::string bad = replace(good, "[ground]", "[grund]");
+  const SceneError e = load_error(bad);
+  EXPECT_EQ(e.field(), "ground");
+  EXPECT_NE(std::string(e.what()).find("missing table"), std::string::npos) << e.what();
+}
+
+TEST(SceneLoader, WrongUnitIsNamedAsSuch) {
+  const std::string good = read(kScenes / "spatula-sphere.toml");
+  const std::string bad = replace(good, "radius_m = 0.05", "radius_mm = 50");
+  expect_error(load_error(bad), line_of(bad, "radius_mm"), "soft_body.radius_mm", "wrong unit");
+  // Hunt-Crossley per-unit-area stiffness given in per-triangle units.
+  const std::string bad_hc = replace(good, "stiffness_pa_per_m_pow_n", "stiffness_n_per_m_pow_n");
+  expect_error(load_error(bad_hc), line_of(bad_hc, "stiffness_n_per_m_pow_n"), "hunt_crossley.stiffness_n_per_m_pow_n", "wrong unit");
+  // A unit in the value instead of the key is not a number.
+  const std::string bad_value = replace(good, "time_step_s = 0.001", "time_step_s = \"1 ms\"");
+  expect_error(load_error(bad_value), line_of(bad_value, "time_step_s"), "simulation.time_step_s", "expected a number in seconds");
+}
+
+TEST(SceneLoader, OutOfRangeValueNamesField) {
+  const std::string good = read(kScenes / "spatula-sphere.toml");
+  const std::string bad = replace(good, "linear_stiffness_ratio = 1.0", "linear_stiffness_ratio = 2.0");
+  expect_error(load_error(bad), line_of(bad, "linear_stiffness_ratio"), "soft_body.linear_stiffness_ratio", "must be in");
+  const std::string bad_method = replace(good, "collision_method = \"paired\"", "collision_method = \"magic\"");
+  expect_error(load_error(bad_method), line_of(bad_method, "collision_method"), "simulation.collision_method", "not one of");
+}
+
+TEST(SceneLoader, UnreadableMeshNamesMeshPath) {
+  const std::string good = read(kScenes / "convex-spatula-sphere.toml");
+  const std::string missing = replace(good, "meshes/convex-spatula.obj", "meshes/no-such-mesh.obj");
+  expect_error(load_error(missing), line_of(missing, "mesh_path"), "tool.mesh_path", "unreadable mesh");
+
+  // A readable OBJ that is not a closed convex mesh (one triangle) is refused too.
+  const auto dir = std::filesystem::temp_directory_path() / "fissure_scene_loader_test";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream obj(dir / "open.obj");
+    obj << "v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n";
+  }
+  const std::string open = replace(good, "meshes/convex-spatula.obj", (dir / "open.obj").string());
+  expect_error(load_error(open), line_of(open, "mesh_path"), "tool.mesh_path", "unreadable mesh");
+}
+
+TEST(SceneLoader, BadTomlSyntaxNamesLine) {
+  const std::string good = read(kScenes / "spatula-sphere.toml");
+  const std::string bad = replace(good, "radius_m = 0.05", "radius_m = = 0.05");
+  const SceneError e = load_error(bad);
+  EXPECT_EQ(e.line(), line_of(bad, "radius_m = = 0.05"));
+  EXPECT_NE(std::string(e.what()).find("bad.toml:"), std::string::npos);
+  EXPECT_NE(std::string(e.what()).find("TOML syntax error"), std::string::npos) << e.what();
+}
+
+TEST(SceneLoader, UnreadableFileAndUnknownSceneName) {
+  EXPECT_THROW((void)load_scene("scenes/definitely-not-here.toml"), SceneError);
+  EXPECT_THROW((void)resolve_scene_path("definitely-not-a-scene"), SceneError);
+  EXPECT_EQ(resolve_scene_path("clamp-vessel").filename(), "clamp-vessel.toml");
+}
+
+TEST(SceneLoader, ClampSceneNeedsClampMode) {
+  const std::string good = read(kScenes / "clamp-sphere.toml");
+  const std::string bad = replace(good, "clamp_mode = true", "clamp_mode = false");
+  expect_error(load_error(bad), line_of(bad, "clamp_mode = false"), "device_mapping.clamp_mode", "clamp_mode = true");
+}
+
+TEST(SceneTrajectory, LegsAndHoldsAreSampledLinearly) {
+  SceneDescription scene = load_scene(kScenes / "spatula-sphere.toml");
+  // start y 0.12 → 0.092 at 0.05 m/s (0.56 s), hold 0.5 s, → 0.12 (0.56 s), hold 0.1 s.
+  EXPECT_NEAR(trajectory_duration_s(scene), 0.56 + 0.5 + 0.56 + 0.1, 1e-9);
+  EXPECT_NEAR(sample_trajectory(scene, 0.0).pose.position_world_m[1], 0.12, 1e-12);
+  EXPECT_NEAR(sample_trajectory(scene, 0.28).pose.position_world_m[1], 0.106, 1e-9);
+  EXPECT_NEAR(sample_trajectory(scene, 0.8).pose.position_world_m[1], 0.092, 1e-12);
+  EXPECT_NEAR(sample_trajectory(scene, 1.06 + 0.28).pose.position_world_m[1], 0.106, 1e-9);
+  EXPECT_NEAR(sample_trajectory(scene, 100.0).pose.position_world_m[1], 0.12, 1e-12);
+
+  // The clamp's jaw gap closes over the leg at the leg's speed.
+  const SceneDescription clamp = load_scene(kScenes / "clamp-sphere.toml");
+  EXPECT_NEAR(sample_trajectory(clamp, 0.0).jaw_gap_m, 0.12, 1e-12);
+  EXPECT_NEAR(sample_trajectory(clamp, 1.0).jaw_gap_m, 0.10, 1e-9);   // 0.02 m/s for 1 s
+  EXPECT_NEAR(sample_trajectory(clamp, 2.2).jaw_gap_m, 0.08, 1e-12);  // closed and held
+}
+
+}  // namespace
+}  // namespace fissure::host
