@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include "bench_kinematics.hpp"
+#include "bench_rt.hpp"
 #include "commands.hpp"
 #include "device_kinematics.hpp"
 #include "device_usb.hpp"
@@ -51,6 +52,7 @@ int main(int argc, char** argv) {
   fissure::app::register_device_kinematics(tree);
   fissure::app::register_bench_kinematics(tree);
   fissure::app::register_sim(tree);
+  fissure::app::register_bench_rt(tree);
 
   if (const std::string unknown = unknown_subcommand(root, argc, argv); !unknown.empty()) {
     std::fprintf(stderr, "fissure: error: %s (see 'fissure --help')\n", unknown.c_str());
