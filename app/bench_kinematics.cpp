@@ -297,7 +297,7 @@ void print_row(const SolveStats& s) {
 struct Arguments {
   std::string json_path;
   std::size_t samples = 20000;
-  int repeats = 3;
+  int repeats = 5;
   std::uint64_t seed = 2024;
 };
 
@@ -453,7 +453,7 @@ void register_bench_kinematics(CommandTree& tree) {
   command->add_option("--json", arguments->json_path, "write the results as JSON to FILE")->required();
   command->add_option("--samples", arguments->samples, "hand-trajectory samples at 1 kHz (default 20000)")
       ->check(CLI::Range(std::size_t{128}, std::size_t{10'000'000}));
-  command->add_option("--repeats", arguments->repeats, "timed passes over the samples (default 3)")
+  command->add_option("--repeats", arguments->repeats, "timed passes over the samples (default 5)")
       ->check(CLI::Range(1, 100));
   command->add_option("--seed", arguments->seed, "trajectory seed (default 2024)");
   command->callback([arguments] { run(*arguments); });

@@ -18,8 +18,8 @@ struct ArmFrames {
   std::array<double, 3> sin_phi{};
 };
 
-/// std::cos/std::sin of the stock φ doubles (π/2 + π/12, …) as glibc computes them, so the
-/// fast path below gives bit-identical results to the general one.
+/// std::cos/std::sin of the stock φ doubles (π/2 + π/12, …) as x86-64 glibc computes them,
+/// so the fast path matches the general one bit for bit there (within an ulp elsewhere).
 inline constexpr ArmFrames kStockArmFrames{
     {-0.25881904510252063, 0.96592582628906831, -0.70710678118654746},
     {0.96592582628906831, -0.25881904510252074, -0.70710678118654757}};
