@@ -12,8 +12,11 @@
 //     frame) enters the tool volume is put back on the plane it entered through (Cyrus–Beck
 //     clipping against the tool's convex planes); a node that starts inside (the soft solver
 //     pushed a held node in) goes back to the plane it was held on, else to the nearest one.
-//     This covers the tool's area between nodes and its rim. Triangles around a guarded node count
-//     as contacted (they have a colliding node) for the force.
+//     This covers the tool's area between nodes and its rim.
+// Colliding soft nodes = nodes moved this step, plus nodes held last step that are still within
+// release_distance in front of their plane (hysteresis against contact-set chatter). Every
+// triangle around a colliding node is in the force set (paper: "at least one of the nodes
+// belonging to the triangle is in a colliding state"), pushing along its node's plane.
 // ray (the paper's Fig. 3 right): every tool node in contact, excluded or not, puts its triangle's
 // vertices on ITS OWN plane when behind it, in node order — with both faces in contact the last
 // one wins, so vertices get pushed to the far face: the instability the pairing removes.

@@ -59,8 +59,9 @@ struct ThinBodyCollisionParams {
 // / jaw it is on, and this triangle's share of the force).
 struct ContactRecord {
   int soft_face = -1;                 // index into btSoftBody::m_faces
-  int tool_node = -1;                 // leading tool node (-1: contact found by the soft-node guard)
-  int tool_plane = -1;                // tool face (index into ToolNodes::planes()) the triangle lies on
+  int tool_node = -1;                 // leading tool node that hit it this step on tool_plane (-1: none —
+                                      // in the set because one of its soft nodes is colliding)
+  int tool_plane = -1;                // tool face (index into ToolNodes::planes()) its colliding node is held on
   int jaw = 0;                        // ThinBodyCollisionParams::jaw
   Eigen::Vector3d point_world_m = Eigen::Vector3d::Zero();   // triangle centroid after the response
   Eigen::Vector3d normal_world = Eigen::Vector3d::Zero();    // tool face outward normal (world)
@@ -76,7 +77,7 @@ struct CollisionStepResult {
   int colliding_tool_nodes = 0;   // tool nodes in contact after the exclusion
   int excluded_pairs = 0;         // tool nodes excluded as the non-leading node of a pair in contact
   int both_face_contacts = 0;     // pairs with both nodes pushing (always 0 for paired; ray's instability)
-  int contacted_triangles = 0;
+  int contacted_triangles = 0;    // triangles with a colliding soft node (= contacts.size())
   int displaced_soft_nodes = 0;   // soft nodes written by the enforced displacement
   int guard_corrections = 0;      // soft nodes the swept soft-node guard had to put back (paired only)
   bool broad_phase_hit = false;
