@@ -357,6 +357,29 @@ TEST(PairedCollision, DampingAddsForceWhilePressingAndTheForceNeverGoesNegative)
   EXPECT_GT(with_damping.force_n.back(), elastic.force_n.back());
 }
 
+TEST(PairedCollision, FixedSoftNodesAreNeverMoved) {
+  test_scene::SoftWorld world(false);
+  world.add_slab(0.1, 20);
+  const int centre = 10 * 21 + 10;  // the node at the slab's centre, under the plate
+  world.soft().setMass(centre, 0);  // Bullet: mass 0 = fixed (m_im = 0)
+  const btVector3 fixed_position = world.soft().m_nodes[centre].m_x;
+  const ToolNodes tool = test_scene::plate_tool(0.004);
+  auto collision = make_paired_collision(tool, world.soft(), ThinBodyCollisionParams{});
+  CollisionStepResult result;
+  ToolPose previous;
+  previous.position_world_m = Eigen::Vector3d(0, 0.0025, 0);
+  for (int s = 1; s <= 10; ++s) {
+    ToolPose current = previous;
+    current.position_world_m.y() = 0.0025 - 0.0003 * s;  // bottom face ends 2.5 mm below the slab
+    world.step_without_dynamics();
+    collision->step(previous, current, kStep_s, world.soft(), result);
+    previous = current;
+  }
+  EXPECT_EQ(world.soft().m_nodes[centre].m_x, fixed_position);
+  EXPECT_LT(world.soft().m_nodes[centre + 1].m_x.y(), -0.0024) << "its free neighbour went down with the plate";
+  EXPECT_GT(result.displaced_soft_nodes, 0);
+}
+
 TEST(PairedCollision, RejectsAnotherSoftBodyAndBadParameters) {
   test_scene::SoftWorld world(true);
   world.add_sphere();
