@@ -1,0 +1,378 @@
+#include "session_runner.hpp"
+
+#include <sys/utsname.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <memory>
+#include <thread>
+
+#include <spdlog/spdlog.h>
+
+#include "commands.hpp"
+#include "fissure/falcon_hw/falcon_usb_driver.hpp"
+#include "fissure/falcon_hw/libusb_transport.hpp"
+#include "fissure/falcon_hw/sim_falcon.hpp"
+#include "fissure/rt_core/faults.hpp"
+#include "fissure/rt_core/rt_config.hpp"
+#include "fissure/rt_core/rt_loop.hpp"
+#include "fissure/rt_core/rt_thread.hpp"
+#include "fissure/shared/clock.hpp"
+#include "fissure/shared/spsc_ring.hpp"
+#include "session_host.hpp"
+
+namespace fissure::app {
+namespace {
+
+using WallClock = std::chrono::steady_clock;
+
+/// Status line refresh [s]: ~10×/s (issue 6), slow enough not to cost the host thread CPU.
+constexpr double kStatusPeriod_s = 0.1;
+/// How often the main thread drains telemetry in real time [ms]: the 8192-sample ring holds
+/// 8 s at 1 kHz, so 10 ms is far inside it and keeps Ctrl-C responsive.
+constexpr int kDrainPeriod_ms = 10;
+/// Host statuses buffered between drains: 4096 host steps ≥ 4 s at 1 kHz.
+constexpr std::size_t kHostStatusCapacity = 4096;
+
+// Big (the telemetry ring is ~2 MB): lives on the heap, built once before the loop starts.
+struct Exchanges {
+  rt::ProxyExchange proxy;
+  rt::DeviceStateExchange state;
+  rt::TelemetryRing telemetry;
+  SpscRing<HostStatus, kHostStatusCapacity> host_status;
+};
+
+// The USB Falcon: transport and driver, opened, firmware checked and homed (not for lockstep).
+struct UsbFalcon {
+  std::unique_ptr<falcon::LibusbFalconTransport> transport;
+  std::unique_ptr<falcon::FalconUsbDriver> driver;
+};
+
+UsbFalcon open_usb_falcon(Clock& clock) {
+  UsbFalcon usb;
+  std::string error;
+  usb.transport = falcon::LibusbFalconTransport::open(0, error);
+  if (!usb.transport) throw CommandError("--device usb: " + error);
+  usb.driver = std::make_unique<falcon::FalconUsbDriver>(*usb.transport, clock);
+  if (!usb.driver->open()) throw CommandError(std::string("--device usb: ") + usb.driver->error());
+  if (!usb.driver->check_firmware()) {
+    throw CommandError("--device usb: Novint Falcon firmware not loaded: run 'fissure device firmware --file F' first");
+  }
+  std::fprintf(stderr, "homing: pull the grip all the way out, then push it all the way in …\n");
+  if (!usb.driver->home([](std::uint8_t mask) { std::fprintf(stderr, "  arms homed: 0x%x\n", mask); })) {
+    throw CommandError(std::string("--device usb: homing failed: ") + usb.driver->error());
+  }
+  return usb;
+}
+
+nlohmann::json machine_info() {
+  nlohmann::json machine;
+  machine["nproc"] = std::thread::hardware_concurrency();
+  std::string cpu_model = "unknown";
+  std::ifstream cpuinfo("/proc/cpuinfo");
+  for (std::string line; std::getline(cpuinfo, line);) {
+    if (line.rfind("model name", 0) == 0) {
+      cpu_model = line.substr(line.find(':') + 2);
+      break;
+    }
+  }
+  machine["cpu_model"] = cpu_model;
+  utsname names{};
+  if (uname(&names) == 0) machine["kernel"] = std::string(names.sysname) + " " + names.release + " " + names.version;
+  return machine;
+}
+
+nlohmann::json quantile_json(std::vector<double> values) {
+  const Quantiles q = quantiles(values);
+  return {{"median", q.median}, {"p99", q.p99}, {"max", q.max}};
+}
+
+nlohmann::json fault_names(std::uint32_t bits) {
+  nlohmann::json names = nlohmann::json::array();
+  for (std::uint32_t bit = 1; bit != 0 && bit <= rt::kAnyFault; bit <<= 1u) {
+    if ((bits & bit) != 0) names.push_back(rt::fault_name(bit));
+  }
+  return names;
+}
+
+// Prints the status line: in place on a terminal, one line per second otherwise (logs, CI).
+class StatusPrinter {
+ public:
+  explicit StatusPrinter(bool enabled) : enabled_(enabled), tty_(isatty(STDERR_FILENO) == 1) {}
+  void maybe_print(const SessionRecorder& recorder, double session_time_s, std::uint64_t ticks, std::uint64_t host_steps) {
+    if (!enabled_) return;
+    const WallClock::time_point now = WallClock::now();
+    const double since = std::chrono::duration<double>(now - last_).count();
+    if (since < (tty_ ? kStatusPeriod_s : 1.0)) return;
+    const double tick_rate = static_cast<double>(ticks - last_ticks_) / since;
+    const double host_rate = static_cast<double>(host_steps - last_host_steps_) / since;
+    const std::string line = recorder.status_line(session_time_s, tick_rate, host_rate);
+    std::fprintf(stderr, tty_ ? "\r%s\033[K" : "%s\n", line.c_str());
+    last_ = now;
+    last_ticks_ = ticks;
+    last_host_steps_ = host_steps;
+    printed_ = true;
+  }
+  void finish() {
+    if (enabled_ && tty_ && printed_) std::fprintf(stderr, "\n");
+  }
+
+ private:
+  bool enabled_;
+  bool tty_;
+  bool printed_ = false;
+  WallClock::time_point last_ = WallClock::now();
+  std::uint64_t last_ticks_ = 0;
+  std::uint64_t last_host_steps_ = 0;
+};
+
+bool interrupted(const SessionOptions& options) {
+  return options.interrupt != nullptr && options.interrupt->load(std::memory_order_relaxed);
+}
+
+}  // namespace
+
+double hand_script_duration_s(const HandScript& hand) {
+  double total = 0.0;
+  Eigen::Vector3d from = as_eigen(hand.start_position_device_m);
+  for (const HandWaypoint& leg : hand.waypoints) {
+    const Eigen::Vector3d to = as_eigen(leg.position_device_m);
+    if (leg.speed_m_per_s > 0.0) total += (to - from).norm() / leg.speed_m_per_s;
+    total += leg.hold_s;
+    from = to;
+  }
+  return total;
+}
+
+host::SceneDescription scene_at_host_rate(const host::SceneDescription& scene, double host_rate_hz) {
+  host::SceneDescription out = scene;
+  if (host_rate_hz <= 0.0) return out;
+  const double sub_step_s = scene.simulation.time_step_s / scene.simulation.substeps_count;
+  const double host_dt_s = 1.0 / host_rate_hz;
+  const double substeps = host_dt_s / sub_step_s;
+  const long rounded = std::lround(substeps);
+  if (rounded < 1 || std::abs(substeps - static_cast<double>(rounded)) > 1e-6 * substeps) {
+    throw CommandError("--host-rate " + std::to_string(host_rate_hz) + " Hz: the host period must be a whole number of the scene's " +
+                       std::to_string(sub_step_s * 1e3) + " ms collision sub-steps");
+  }
+  out.simulation.time_step_s = host_dt_s;
+  out.simulation.substeps_count = static_cast<int>(rounded);
+  return out;
+}
+
+SessionOutcome run_session(const SessionOptions& options) {
+  const host::SceneDescription scene = scene_at_host_rate(options.scene, options.host_rate_hz);
+  if (options.lockstep && options.device == SessionDevice::kUsb) {
+    throw CommandError("--lockstep runs on simulated time: it needs --device sim, not the USB Falcon");
+  }
+  rt::RtConfig config;
+  config.rate_hz = options.rt_rate_hz;
+  config.mapping = scene.device_mapping;
+  rt::RtModel model;
+  const char* config_error = nullptr;
+  if (!rt::build_model(config, model, &config_error)) throw CommandError(std::string("rt config: ") + config_error);
+
+  const double host_dt_s = scene.simulation.time_step_s;
+  double duration_s = options.duration_s;
+  if (duration_s <= 0.0 && options.device == SessionDevice::kSim) duration_s = hand_script_duration_s(scene.hand);
+  if (duration_s <= 0.0 && options.lockstep) throw CommandError("--lockstep needs a duration: the scene's hand script is empty");
+  const bool until_interrupted = duration_s <= 0.0;
+
+  SessionHost host(scene);
+  host.settle(options.settle_s);
+
+  const double expected_s = until_interrupted ? 60.0 : duration_s + 1.0;
+  SessionRecorder recorder(options.out_dir, static_cast<std::size_t>(expected_s * options.rt_rate_hz),
+                           static_cast<std::size_t>(expected_s / host_dt_s));
+  auto exchanges = std::make_unique<Exchanges>();
+  StatusPrinter status(options.status_line);
+  nlohmann::json extra;
+  const WallClock::time_point wall_start = WallClock::now();
+  double session_time_s = 0.0;
+  std::uint64_t proxies_rejected = 0;
+  std::uint64_t host_late_steps = 0;
+  std::uint64_t host_status_dropped = 0;
+  double wakeup_p99_us = 0.0;
+  double wakeup_max_us = 0.0;
+  double max_tick_us = 0.0;
+  std::string device_name;
+
+  falcon::SimFalconConfig sim_config;
+  sim_config.hand = scene.hand;
+
+  if (options.lockstep) {
+    LockstepClock clock(0);
+    falcon::SimFalcon device(sim_config, clock);
+    device_name = device.name();
+    rt::RtLoop loop(model, device, clock, exchanges->proxy, exchanges->state, exchanges->telemetry);
+    const double ratio = host_dt_s / model.period_s;
+    const auto ticks_per_host = static_cast<std::uint64_t>(std::llround(ratio));
+    if (ticks_per_host < 1 || std::abs(ratio - static_cast<double>(ticks_per_host)) > 1e-6 * ratio) {
+      throw CommandError("--lockstep: the host period (" + std::to_string(host_dt_s * 1e3) +
+                         " ms) must be a whole number of rt periods (" + std::to_string(model.period_s * 1e3) + " ms)");
+    }
+    const auto end_ns = static_cast<TimeNs>(std::llround(duration_s * 1e9));
+    rt::TelemetrySample sample;
+    while (!loop.stopped()) {
+      if (clock.now() >= end_ns || interrupted(options)) loop.request_stop();
+      for (std::uint64_t k = 0; k < ticks_per_host && !loop.stopped(); ++k) loop.step();
+      const HostStatus& host_status = host.step(exchanges->state, exchanges->proxy);
+      recorder.add_host_step(host_status);
+      while (exchanges->telemetry.try_pop(sample)) recorder.add_tick(sample, host_status);
+      session_time_s = to_seconds(clock.now());
+      status.maybe_print(recorder, session_time_s, recorder.figures().ticks, recorder.figures().host_steps);
+    }
+    loop.send_zero_command();
+    proxies_rejected = loop.data().proxy.rejected_count;
+    extra["sim_falcon"] = {{"exchanges", device.counters().exchanges},
+                           {"kinematics_failures", device.counters().kinematics_failures}};
+  } else {
+    MonotonicClock clock;
+    std::unique_ptr<falcon::HapticDevice> device;
+    UsbFalcon usb;
+    if (options.device == SessionDevice::kUsb) {
+      usb = open_usb_falcon(clock);
+    } else {
+      device = std::make_unique<falcon::SimFalcon>(sim_config, clock);
+    }
+    falcon::HapticDevice& haptic = usb.driver ? static_cast<falcon::HapticDevice&>(*usb.driver) : *device;
+    device_name = haptic.name();
+    rt::RtLoop loop(model, haptic, clock, exchanges->proxy, exchanges->state, exchanges->telemetry);
+    std::atomic<bool> stop_rt{false};
+    std::atomic<bool> rt_done{false};
+    std::atomic<bool> stop_host{false};
+    std::atomic<std::uint64_t> late{0};
+    std::atomic<std::uint64_t> dropped{0};
+    rt::RtSetupReport setup_report;
+    std::string host_error;
+    const TimeNs start_ns = clock.now();
+    const TimeNs end_ns = until_interrupted ? std::numeric_limits<TimeNs>::max()
+                                            : start_ns + static_cast<TimeNs>(std::llround(duration_s * 1e9));
+
+    std::thread rt_thread([&] {
+      rt::RtThreadSetup setup;
+      rt::RtThreadConfig thread_config;
+      thread_config.policy = rt::RtPolicy::kBestEffort;
+      setup_report = setup.apply(thread_config);
+      loop.run_until(end_ns, stop_rt);
+      rt_done.store(true, std::memory_order_release);
+    });
+    std::thread host_thread([&] {
+      const auto period_ns = static_cast<TimeNs>(std::llround(host_dt_s * 1e9));
+      TimeNs next = clock.now();
+      while (!stop_host.load(std::memory_order_relaxed)) {
+        try {
+          const HostStatus& st = host.step(exchanges->state, exchanges->proxy);
+          if (!exchanges->host_status.try_push(st)) dropped.fetch_add(1, std::memory_order_relaxed);
+        } catch (const std::exception& e) {
+          host_error = e.what();
+          stop_rt.store(true);  // the proxy goes stale and fades; ramp out and stop
+          return;
+        }
+        next += period_ns;
+        const TimeNs now = clock.now();
+        if (now > next) {
+          // Behind: count it and restart the schedule from now (no burst of catch-up steps).
+          late.fetch_add(1, std::memory_order_relaxed);
+          next = now;
+        } else {
+          clock.sleep_until(next);
+        }
+      }
+    });
+
+    rt::TelemetrySample sample;
+    HostStatus host_status;
+    auto drain = [&] {
+      while (exchanges->host_status.try_pop(host_status)) recorder.add_host_step(host_status);
+      while (exchanges->telemetry.try_pop(sample)) recorder.add_tick(sample, host_status);
+    };
+    while (!rt_done.load(std::memory_order_acquire)) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(kDrainPeriod_ms));
+      if (interrupted(options)) stop_rt.store(true);
+      drain();
+      session_time_s = to_seconds(clock.now() - start_ns);
+      status.maybe_print(recorder, session_time_s, recorder.figures().ticks, recorder.figures().host_steps);
+    }
+    rt_thread.join();
+    stop_host.store(true);
+    host_thread.join();
+    drain();
+    if (!host_error.empty()) spdlog::error("host thread stopped: {}", host_error);
+    proxies_rejected = loop.data().proxy.rejected_count;
+    host_late_steps = late.load();
+    host_status_dropped = dropped.load();
+    wakeup_p99_us = loop.stats().wakeup.quantile_us(0.99);
+    wakeup_max_us = loop.stats().wakeup.quantile_us(1.0);
+    max_tick_us = static_cast<double>(loop.stats().max_tick_ns) * 1e-3;
+    extra["rt_setup"] = {{"sched_fifo", setup_report.sched_fifo},
+                         {"memory_locked", setup_report.memory_locked},
+                         {"warnings", std::string(setup_report.message)}};
+    if (setup_report.message[0] != '\0') spdlog::warn("rt thread: {}", setup_report.message);
+    if (!host_error.empty()) extra["host_error"] = host_error;
+  }
+  status.finish();
+  recorder.close_trace();
+  const double wall_s = std::chrono::duration<double>(WallClock::now() - wall_start).count();
+
+  const SessionFigures& f = recorder.figures();
+  nlohmann::json summary;
+  summary["scene"] = scene.name;
+  summary["mode"] = options.lockstep ? "lockstep" : "realtime";
+  summary["device"] = device_name;
+  summary["duration_s"] = session_time_s;
+  summary["wall_s"] = wall_s;
+  summary["rt_rate_hz"] = options.rt_rate_hz;
+  summary["host_rate_hz"] = 1.0 / host_dt_s;
+  summary["ticks"] = f.ticks;
+  summary["tick_rate_hz"] = session_time_s > 0.0 ? static_cast<double>(f.ticks) / session_time_s : 0.0;
+  summary["crossed_nodes_max"] = f.crossed_nodes_max;
+  summary["faults"] = f.fault_ticks;
+  summary["fault_kinds"] = fault_names(f.fault_bits_seen);
+  summary["proxies_rejected"] = proxies_rejected;
+  summary["overruns"] = f.overruns;
+  summary["force_max_n"] = f.force_max_n;
+  summary["force_limit_n"] = model.config.safety.max_force_n;
+  summary["contact_force_max_n"] = f.contact_force_max_n;
+  summary["host_force_max_n"] = f.host_force_max_n;
+  std::vector<double> ages = f.proxy_age_ms;
+  summary["proxy_age_ms"] = quantile_json(std::move(ages));
+  summary["energy_j"] = f.energy_j;
+  summary["energy_max_j"] = f.energy_max_j;
+  summary["contact_depth_max_mm"] = f.rt_penetration_max_m * 1e3;
+  summary["host_penetration_max_mm"] = f.host_penetration_max_m * 1e3;
+  summary["host_steps"] = f.host_steps;
+  summary["host_step_ms"] = quantile_json(f.host_step_ms);
+  summary["host_late_steps"] = host_late_steps;
+  summary["host_status_dropped"] = host_status_dropped;
+  if (!options.lockstep) {
+    summary["wakeup_latency_us"] = {{"p99", wakeup_p99_us}, {"max", wakeup_max_us}};
+    summary["max_tick_us"] = max_tick_us;
+  }
+  summary["telemetry_samples"] = f.telemetry_samples;
+  for (const auto& [key, value] : extra.items()) summary[key] = value;
+  summary["machine"] = machine_info();
+
+  SessionOutcome outcome;
+  outcome.trace_path = recorder.trace_path();
+  outcome.summary_path = options.out_dir / "summary.json";
+  {
+    std::ofstream out(outcome.summary_path);
+    if (!out) throw CommandError("cannot write '" + outcome.summary_path.string() + "'");
+    out << summary.dump(2) << "\n";
+  }
+  if (options.plot) {
+    std::string error;
+    outcome.plot_path = plot_session(outcome.trace_path, options.out_dir / "session.png",
+                                     scene.name + (options.lockstep ? " (lockstep)" : " (real time)"), error);
+    if (outcome.plot_path.empty()) spdlog::warn("{}", error);
+  }
+  outcome.summary = std::move(summary);
+  return outcome;
+}
+
+}  // namespace fissure::app
