@@ -244,6 +244,29 @@ TEST(RtLoop, LockstepDeadlinesAreExactPeriods) {
   EXPECT_EQ(s.loop->stats().wakeup.max_ns, 0);
 }
 
+TEST(RtLoop, RendersTheSameWallAtEveryRateFrom500HzTo10kHz) {
+  for (const double rate : {500.0, 1000.0, 2000.0, 4000.0, 8000.0, 10000.0}) {
+    RtConfig config;
+    config.rate_hz = rate;
+    falcon::SimFalconConfig sim;
+    sim.hand = press_hold_release(0.01, 0.5, 0.05);
+    Session s(config, sim);
+    const auto ticks = static_cast<int>(1.2 * rate);  // to the middle of the hold
+    for (int k = 0; k < ticks; ++k) {
+      if (k % std::max(1, static_cast<int>(rate / 1000.0)) == 0) {
+        s.proxy_in.publish(plane_proxy(static_cast<std::uint64_t>(k + 1), {0.0, -0.004, 0.0}, {0.0, 1.0, 0.0}, 500.0));
+      }
+      s.loop->step();
+    }
+    EXPECT_EQ(s.clock.now(), ticks * s.model.period_ns) << rate;
+    EXPECT_EQ(s.loop->data().faults.fault_ticks, 0u) << rate;
+    // Hand spring 300 N/m pulling 6 mm past the wall against 500 N/m: x ≈ 2.25 mm, F ≈ 1.1 N.
+    const double penetration = -0.004 - s.loop->data().p_device_m.y();
+    EXPECT_NEAR(penetration, 300.0 * 0.006 / 800.0, 0.4e-3) << rate;
+    EXPECT_NEAR(s.loop->data().force_device_n.y(), 500.0 * penetration, 0.05) << rate;
+  }
+}
+
 TEST(RtLoop, StopRampsOutAndLeavesTheDeviceWithoutForce) {
   falcon::SimFalconConfig sim;
   sim.hand = press_hold_release(0.01, 5.0, 0.05);
