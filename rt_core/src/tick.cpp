@@ -164,7 +164,9 @@ TickResult tick(const RtModel& model, RtData& data, TickIo& io, const TickTiming
   // 5. DeviceState to the host, telemetry to the logger
   DeviceState state;
   state.sequence = ++data.device_state_sequence;
-  state.sample_time_ns = now_ns;
+  // When the encoders were read: the device's receive time if it reports one, else the tick's.
+  state.sample_time_ns =
+      data.have_position && data.reading.receive_time_ns != 0 ? data.reading.receive_time_ns : now_ns;
   state.position_device_m = to_vec3(data.kinematics.p_device_m);
   state.velocity_device_m_per_s = to_vec3(data.v_device_m_per_s);
   state.closing_axis_m = jaw_closing_m(config.mapping, data.kinematics.p_device_m);
