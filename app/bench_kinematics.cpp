@@ -340,6 +340,18 @@ void run(const Arguments& args) {
   }
   const SolveStats warm_default = measure_fk(true, falcon::kDefaultFkTolerance_rad, trajectory, args.repeats);
   const SolveStats cold_default = measure_fk(false, falcon::kDefaultFkTolerance_rad, trajectory, args.repeats);
+  // What the rt loop needs per tick: the position and J at it, in one call.
+  std::vector<Eigen::Matrix3d> fk_jacobians(count);
+  const SolveStats warm_with_jacobian = measure(
+      "warm + J (forward_kinematics_with_jacobian)", falcon::kDefaultFkTolerance_rad, trajectory, args.repeats,
+      [&](std::size_t k, std::vector<Eigen::Vector3d>& out) {
+        out[k] = k == 0 ? workspace_centre() : out[k - 1];
+        bool valid = false;
+        return falcon::forward_kinematics_with_jacobian(geometry, trajectory.theta_rad[k], out[k],
+                                                        FkOptions{falcon::kDefaultFkTolerance_rad,
+                                                                  falcon::kDefaultFkMaxIterations},
+                                                        fk_jacobians[k], valid);
+      });
 
   namespace ref = falcon::libnifalcon_reference;
   const SolveStats baseline = measure_baseline("libnifalcon: guess (0,0,0.08), issue-66 J", false,
@@ -355,6 +367,7 @@ void run(const Arguments& args) {
   std::printf("default tolerance %.0e rad:\n", falcon::kDefaultFkTolerance_rad);
   print_row(warm_default);
   print_row(cold_default);
+  print_row(warm_with_jacobian);
 
   const auto [ik_median_ns, ik_p99_ns] = time_call(count, args.repeats, [&, out = Eigen::Vector3d{}](std::size_t k) mutable {
     (void)falcon::inverse_kinematics(geometry, trajectory.p_device_m[k], out);
@@ -413,6 +426,8 @@ void run(const Arguments& args) {
   out["fk_warm_p99_ns"] = warm_default.p99_ns;
   out["fk_warm_max_error_m"] = warm_default.error_max_m;
   out["fk_warm_iterations_max"] = warm_default.iterations_max;
+  out["fk_warm_with_jacobian_median_ns"] = warm_with_jacobian.median_ns;
+  out["fk_warm_with_jacobian_p99_ns"] = warm_with_jacobian.p99_ns;
   out["fk_cold_median_ns"] = cold_default.median_ns;
   out["fk_cold_p99_ns"] = cold_default.p99_ns;
   out["fk_cold_max_error_m"] = cold_default.error_max_m;

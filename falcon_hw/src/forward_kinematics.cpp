@@ -37,8 +37,12 @@ FkResult failed_result() noexcept {
   return failed;
 }
 
+/// When dp_dtheta_out is given, it receives J = (∂θ/∂p)⁻¹ at the returned p — the derivative
+/// the last evaluation already computed — and *dp_dtheta_valid says whether that worked.
 FkResult newton(const FalconGeometry& geometry, const detail::ArmFrames& frames, const Eigen::Vector3d& theta_target,
-                Eigen::Vector3d& p, const FkOptions& options) noexcept {
+                Eigen::Vector3d& p, const FkOptions& options, Eigen::Matrix3d* dp_dtheta_out = nullptr,
+                bool* dp_dtheta_valid = nullptr) noexcept {
+  if (dp_dtheta_valid != nullptr) *dp_dtheta_valid = false;
   // IK only ever yields |θ1| < 90°, so a target outside that is unreachable; inside it the
   // residual can be formed in tan(θ1/2) without an atan per evaluation (solve_residual).
   if (!(theta_target.cwiseAbs().maxCoeff() < std::numbers::pi / 2.0)) return failed_result();
@@ -88,6 +92,7 @@ FkResult newton(const FalconGeometry& geometry, const detail::ArmFrames& frames,
     result.residual_rad = max_abs(residual);
   }
   result.converged = result.residual_rad < options.tolerance_rad;
+  if (dp_dtheta_out != nullptr) *dp_dtheta_valid = detail::invert_derivative(dtheta_dp, *dp_dtheta_out);
   return result;
 }
 
@@ -96,6 +101,13 @@ FkResult newton(const FalconGeometry& geometry, const detail::ArmFrames& frames,
 FkResult forward_kinematics(const FalconGeometry& geometry, const Eigen::Vector3d& theta_rad,
                             Eigen::Vector3d& p_device_m, const FkOptions& options) noexcept {
   return newton(geometry, detail::make_arm_frames(geometry), theta_rad, p_device_m, options);
+}
+
+FkResult forward_kinematics_with_jacobian(const FalconGeometry& geometry, const Eigen::Vector3d& theta_rad,
+                                          Eigen::Vector3d& p_device_m, const FkOptions& options,
+                                          Eigen::Matrix3d& dp_dtheta, bool& dp_dtheta_valid) noexcept {
+  return newton(geometry, detail::make_arm_frames(geometry), theta_rad, p_device_m, options, &dp_dtheta,
+                &dp_dtheta_valid);
 }
 
 FkResult forward_kinematics_cold(const FalconGeometry& geometry, const Eigen::Vector3d& theta_rad,

@@ -309,6 +309,36 @@ TEST(ForwardKinematics, WarmStartAlongATrajectoryTakesFewIterations) {
   EXPECT_LE(worst_iterations, 4);
 }
 
+TEST(ForwardKinematics, WithJacobianReturnsTheJacobianAtTheSolution) {
+  const auto starts = sample_workspace(500, 26);
+  const auto targets = sample_workspace(500, 27);
+  for (std::size_t k = 0; k < starts.size(); ++k) {
+    Eigen::Vector3d theta;
+    ASSERT_TRUE(inverse_kinematics(kGeometry, targets[k], theta));
+    Eigen::Vector3d p_plain = starts[k];
+    Eigen::Vector3d p_with = starts[k];
+    Eigen::Matrix3d dp_dtheta;
+    bool valid = false;
+    const FkResult plain = forward_kinematics(kGeometry, theta, p_plain, FkOptions{});
+    const FkResult with = forward_kinematics_with_jacobian(kGeometry, theta, p_with, FkOptions{}, dp_dtheta, valid);
+    ASSERT_TRUE(valid);
+    EXPECT_EQ(p_plain, p_with);
+    EXPECT_EQ(plain.iterations, with.iterations);
+    Eigen::Matrix3d expected;
+    ASSERT_TRUE(jacobian(kGeometry, p_with, expected));
+    EXPECT_LT((dp_dtheta - expected).cwiseAbs().maxCoeff(), 1e-12 * expected.cwiseAbs().maxCoeff());
+  }
+  // Failure before any evaluation: flag false, matrix untouched.
+  Eigen::Vector3d p = workspace_centre();
+  Eigen::Matrix3d untouched = Eigen::Matrix3d::Constant(3.0);
+  bool valid = true;
+  const FkResult failed = forward_kinematics_with_jacobian(
+      kGeometry, Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()), p, FkOptions{}, untouched, valid);
+  EXPECT_FALSE(failed.converged);
+  EXPECT_FALSE(valid);
+  EXPECT_EQ(untouched, Eigen::Matrix3d::Constant(3.0));
+}
+
 TEST(ForwardKinematics, ToleranceAndIterationLimitAreHonoured) {
   const Eigen::Vector3d p = workspace_centre() + Eigen::Vector3d{0.03, -0.02, 0.01};
   Eigen::Vector3d theta;
