@@ -14,6 +14,9 @@ namespace {
 // Relative tolerance for "coplanar" when merging mesh triangles into tool planes and checking
 // convexity: meshes come from float OBJ files, so 1e-6 of the tool size.
 constexpr double kPlaneTolerance_relative = 1e-6;
+// A mesh triangle whose normal is more than 60° off the thin axis is on the rim (an edge node):
+// the flat faces are at 0°, the half-circle rim profile spreads from 0° to 90°.
+constexpr double kEdgeNormalCosine = 0.5;
 
 int other_axis_u(int thin_axis) { return thin_axis == 0 ? 1 : 0; }
 int other_axis_v(int thin_axis) { return thin_axis == 2 ? 1 : 2; }
@@ -105,6 +108,33 @@ ToolNodes ToolNodes::from_box(const BoxToolShape& shape) {
   for (int i = 0; i < per_face; ++i) {
     tool.pair_of_[static_cast<std::size_t>(i)] = i + per_face;
     tool.pair_of_[static_cast<std::size_t>(i + per_face)] = i;
+  }
+  tool.edge_node_.assign(static_cast<std::size_t>(2 * per_face), 0);
+  if (shape.edge_nodes) {
+    // Side faces: normal ±u (long direction v, nodes_v nodes) and ±v (long direction u, nodes_u),
+    // one row in the middle of the thickness. A side face is thinner than the face-grid spacing of
+    // any tool this is used for, so one row across it is enough to meet a soft triangle the rim
+    // pushes into; a soft NODE meeting the rim between rows is the guard's job (as on the faces).
+    // Unpaired: the node opposite an edge node along its normal is on the far rim, a tool length
+    // away — pairing across the length is exactly the pairing across the edge that the paper's
+    // limited ray forbids, and both rims can legitimately touch the soft body at once (a tool
+    // buried in a fissure), so an exclusion between them would drop a real contact.
+    for (const int side_axis : {u, v}) {
+      const int along = side_axis == u ? v : u;
+      const int count = side_axis == u ? shape.nodes_v : shape.nodes_u;
+      for (const double sign : {1.0, -1.0}) {
+        for (int k = 0; k < count; ++k) {
+          Eigen::Vector3d p = Eigen::Vector3d::Zero();
+          p[side_axis] = sign * h[side_axis];
+          p[along] = grid(count, k, h[along]);
+          tool.positions_tool_m_.push_back(p);
+          tool.normals_tool_.push_back(sign * Eigen::Vector3d::Unit(side_axis));
+          tool.plane_of_node_.push_back(2 * side_axis + (sign > 0 ? 0 : 1));
+          tool.pair_of_.push_back(-1);
+          tool.edge_node_.push_back(1);
+        }
+      }
+    }
   }
   for (int corner = 0; corner < 8; ++corner) {
     tool.hull_vertices_tool_m_.emplace_back((corner & 1) ? h.x() : -h.x(), (corner & 2) ? h.y() : -h.y(),
@@ -207,6 +237,10 @@ ToolNodes ToolNodes::from_convex_mesh(const ConvexMeshToolShape& shape) {
   const Eigen::Vector3d extent = tool.bounds_tool_m_.sizes();
   extent.minCoeff(&tool.thin_axis_);
   tool.thickness_m_ = extent[tool.thin_axis_];
+  // Rim triangles: normal more than 60° off the thin axis (|n_thin| < cos 60°).
+  tool.edge_node_.assign(count, 0);
+  for (std::size_t i = 0; i < count; ++i)
+    tool.edge_node_[i] = std::abs(tri_normal[i][tool.thin_axis_]) < kEdgeNormalCosine ? 1 : 0;
   tool.finish_pairing();
   tool.thin_ = shape.pairing_ray_limit_m > 0.0 && tool.report_.mutual + tool.report_.one_way > 0;
   return tool;
@@ -253,6 +287,10 @@ void ToolNodes::finish_pairing() {
     const Eigen::Vector2d n = outward.normalized();
     footprint_halfplanes_.emplace_back(n.x(), n.y(), n.dot(a));
   }
+}
+
+int ToolNodes::edge_node_count() const {
+  return static_cast<int>(std::count(edge_node_.begin(), edge_node_.end(), std::uint8_t{1}));
 }
 
 double ToolNodes::signed_distance_m(const Eigen::Vector3d& p_tool) const {

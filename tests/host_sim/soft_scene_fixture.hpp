@@ -190,6 +190,36 @@ class CrossingTracker {
   double max_penetration_m_ = 0.0;
 };
 
+// How many soft triangles the tool's interior cuts through: each triangle is sampled on a
+// barycentric grid (vertices, edges and interior, `divisions` per edge) and counts when a sample
+// lies deeper than depth_tolerance_m inside the tool volume (tool frame, convex planes). A blade
+// that slices a coarse triangle between its nodes leaves the nodes outside but the triangle's
+// interior inside — the node-based crossing metric cannot see that, this does.
+inline int triangles_cut_by_tool(const ToolNodes& tool, const btSoftBody& soft, const ToolPose& pose,
+                                 double depth_tolerance_m, int divisions = 12, double* deepest_m = nullptr) {
+  int cut = 0;
+  double deepest = 0.0;
+  for (int f = 0; f < soft.m_faces.size(); ++f) {
+    Eigen::Vector3d corner[3];
+    for (int k = 0; k < 3; ++k) {
+      const btVector3& x = soft.m_faces[f].m_n[k]->m_x;
+      corner[k] = pose.to_tool(Eigen::Vector3d(x.x(), x.y(), x.z()));
+    }
+    double face_depth = 0.0;
+    for (int i = 0; i <= divisions; ++i)
+      for (int j = 0; i + j <= divisions; ++j) {
+        const double a = static_cast<double>(i) / divisions;
+        const double b = static_cast<double>(j) / divisions;
+        const Eigen::Vector3d p = corner[0] + a * (corner[1] - corner[0]) + b * (corner[2] - corner[0]);
+        face_depth = std::max(face_depth, -tool.signed_distance_m(p));
+      }
+    deepest = std::max(deepest, face_depth);
+    if (face_depth > depth_tolerance_m) ++cut;
+  }
+  if (deepest_m != nullptr) *deepest_m = deepest;
+  return cut;
+}
+
 struct PlungeOutcome {
   int crossed_nodes = 0;
   double max_penetration_m = 0.0;
@@ -205,6 +235,13 @@ struct PlungeOutcome {
   std::vector<double> force_y_n;  // per step
   std::vector<Eigen::Vector3d> final_nodes;
   std::vector<double> step_seconds;  // collision step wall time per in-contact step
+  double force_y_at_arrival_n = 0.0; // F_y on the step the tool reaches its end height
+  double max_force_y_at_end_n = 0.0; // largest F_y over the arrival step and the hold
+  double soft_top_start_m = 0.0;     // highest soft node (world y) when the tool starts
+  double tool_bottom_end_m = 0.0;    // lowest tool point (world y) at the end of the run
+  int triangles_cut_end = -1;        // soft triangles cut by the tool at the end (spec.check_triangles_cut)
+  double deepest_triangle_point_end_m = 0.0;
+  int max_triangles_cut = -1;        // ... over every step
 };
 
 struct PlungeSpec {
@@ -214,6 +251,13 @@ struct PlungeSpec {
   int hold_steps = 50;
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
   int settle_steps = 100;  // let the sphere settle on the ground before the rest state is taken
+  // > 0: ignore end_height_m and stop when the tool's lowest point is this far below the top of
+  // the settled sphere.
+  double end_depth_into_soft_m = 0.0;
+  // Count soft triangles cut by the tool's interior (triangles_cut_by_tool, deeper than
+  // cut_tolerance_m) after every step.
+  bool check_triangles_cut = false;
+  double cut_tolerance_m = 1e-6;
 };
 
 // Drives the tool straight down (−y) through the sphere at constant speed, then holds.
@@ -231,11 +275,18 @@ inline PlungeOutcome run_sphere_plunge(const ToolNodes& tool, CollisionMethod me
   previous.position_world_m = Eigen::Vector3d(0, spec.start_height_m, 0);
   CrossingTracker tracker(tool, world.node_positions(), previous);
   PlungeOutcome outcome;
+  double below_origin_m = 0.0;  // lowest tool point relative to its origin (world y)
+  for (const auto& p : tool.hull_vertices_tool_m()) below_origin_m = std::min(below_origin_m, (spec.orientation * p).y());
+  outcome.soft_top_start_m = -1e9;
+  for (const auto& p : world.node_positions()) outcome.soft_top_start_m = std::max(outcome.soft_top_start_m, p.y());
+  const double end_height_m = spec.end_depth_into_soft_m > 0.0
+                                  ? outcome.soft_top_start_m - spec.end_depth_into_soft_m - below_origin_m
+                                  : spec.end_height_m;
   const double drop_per_step = spec.speed_m_s * kStep_s;
-  const int move_steps = static_cast<int>(std::ceil((spec.start_height_m - spec.end_height_m) / drop_per_step));
+  const int move_steps = static_cast<int>(std::ceil((spec.start_height_m - end_height_m) / drop_per_step));
   for (int s = 1; s <= move_steps + spec.hold_steps; ++s) {
     ToolPose current = previous;
-    current.position_world_m.y() = std::max(spec.end_height_m, spec.start_height_m - drop_per_step * s);
+    current.position_world_m.y() = std::max(end_height_m, spec.start_height_m - drop_per_step * s);
     world.step_dynamics();
     collision->step(previous, current, kStep_s, world.soft(), result);
     const auto nodes = world.node_positions();
@@ -253,8 +304,16 @@ inline PlungeOutcome run_sphere_plunge(const ToolNodes& tool, CollisionMethod me
     }
     outcome.final_force_y_n = result.force_on_tool_world_n.y();
     outcome.force_y_n.push_back(result.force_on_tool_world_n.y());
+    if (s == move_steps) outcome.force_y_at_arrival_n = result.force_on_tool_world_n.y();
+    if (s >= move_steps) outcome.max_force_y_at_end_n = std::max(outcome.max_force_y_at_end_n, result.force_on_tool_world_n.y());
+    if (spec.check_triangles_cut) {
+      outcome.triangles_cut_end =
+          triangles_cut_by_tool(tool, world.soft(), current, spec.cut_tolerance_m, 12, &outcome.deepest_triangle_point_end_m);
+      outcome.max_triangles_cut = std::max(outcome.max_triangles_cut, outcome.triangles_cut_end);
+    }
     previous = current;
   }
+  outcome.tool_bottom_end_m = previous.position_world_m.y() + below_origin_m;
   outcome.crossed_nodes = tracker.crossed_nodes();
   outcome.max_penetration_m = tracker.max_penetration_m();
   outcome.final_nodes = world.node_positions();

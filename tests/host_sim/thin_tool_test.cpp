@@ -21,14 +21,17 @@ BoxToolShape plate_shape() {
 
 TEST(ToolNodesBox, GridOnBothLargeFacesPairedAcrossTheThickness) {
   const ToolNodes tool = ToolNodes::from_box(plate_shape());
-  ASSERT_EQ(tool.node_count(), 2 * 9 * 7);
-  EXPECT_EQ(tool.pairing_report().mutual, 2 * 9 * 7);
+  // Node count changed with the edge nodes: 2·9·7 face nodes (indices unchanged, first) + the
+  // unpaired edge rows 2·7 (sides normal to x, along z) + 2·9 (sides normal to z, along x).
+  constexpr int kFaceNodes = 2 * 9 * 7;
+  ASSERT_EQ(tool.node_count(), kFaceNodes + 2 * 7 + 2 * 9);
+  EXPECT_EQ(tool.pairing_report().mutual, kFaceNodes);
   EXPECT_EQ(tool.pairing_report().one_way, 0);
-  EXPECT_EQ(tool.pairing_report().unpaired, 0);
+  EXPECT_EQ(tool.pairing_report().unpaired, 2 * 7 + 2 * 9);
   EXPECT_TRUE(tool.is_thin());
   EXPECT_EQ(tool.thin_axis(), 1);
   EXPECT_DOUBLE_EQ(tool.thickness_m(), 0.004);
-  for (int i = 0; i < tool.node_count(); ++i) {
+  for (int i = 0; i < kFaceNodes; ++i) {
     const auto& p = tool.positions_tool_m()[static_cast<std::size_t>(i)];
     const auto& n = tool.normals_tool()[static_cast<std::size_t>(i)];
     const int pair = tool.pair_of()[static_cast<std::size_t>(i)];
@@ -48,6 +51,41 @@ TEST(ToolNodesBox, GridOnBothLargeFacesPairedAcrossTheThickness) {
   double max_x = 0.0;
   for (const auto& p : tool.positions_tool_m()) max_x = std::max(max_x, p.x());
   EXPECT_DOUBLE_EQ(max_x, 0.02);
+}
+
+// Edge (rim) nodes: one row along the middle of each thin side face, at the face grid's
+// positions along its long direction, unpaired, on that side's plane with its outward normal.
+TEST(ToolNodesBox, EdgeNodesOnTheFourSideFacesUnpaired) {
+  const ToolNodes tool = ToolNodes::from_box(plate_shape());
+  constexpr int kFaceNodes = 2 * 9 * 7;
+  ASSERT_EQ(tool.edge_node_count(), 2 * 7 + 2 * 9);
+  int per_side[6] = {0, 0, 0, 0, 0, 0};
+  for (int i = 0; i < tool.node_count(); ++i) {
+    const auto n = static_cast<std::size_t>(i);
+    EXPECT_EQ(tool.edge_node_flags()[n] != 0, i >= kFaceNodes) << "edge nodes come after the face nodes";
+    if (i < kFaceNodes) continue;
+    const Eigen::Vector3d& p = tool.positions_tool_m()[n];
+    const Eigen::Vector3d& normal = tool.normals_tool()[n];
+    EXPECT_EQ(tool.pair_of()[n], -1);
+    EXPECT_DOUBLE_EQ(p.y(), 0.0) << "middle of the thickness";
+    EXPECT_DOUBLE_EQ(normal.y(), 0.0);
+    const int plane_index = tool.plane_of_node()[n];
+    const ToolPlane& plane = tool.planes()[static_cast<std::size_t>(plane_index)];
+    EXPECT_NEAR(plane.normal_tool.dot(p) - plane.offset_m, 0.0, 1e-15) << "on its side face";
+    EXPECT_DOUBLE_EQ(plane.normal_tool.dot(normal), 1.0);
+    EXPECT_DOUBLE_EQ(tool.signed_distance_m(p), 0.0);
+    ++per_side[plane_index];
+  }
+  EXPECT_EQ(per_side[0], 7);  // +x side: along z, nodes_v
+  EXPECT_EQ(per_side[1], 7);
+  EXPECT_EQ(per_side[2], 0);  // large faces ±y: none
+  EXPECT_EQ(per_side[3], 0);
+  EXPECT_EQ(per_side[4], 9);  // +z side: along x, nodes_u
+  EXPECT_EQ(per_side[5], 9);
+  BoxToolShape faces_only = plate_shape();
+  faces_only.edge_nodes = false;
+  EXPECT_EQ(ToolNodes::from_box(faces_only).node_count(), kFaceNodes);
+  EXPECT_EQ(ToolNodes::from_box(faces_only).edge_node_count(), 0);
 }
 
 TEST(ToolNodesBox, SignedDistanceAndFootprint) {
@@ -107,6 +145,15 @@ TEST(RoundedSpatulaMesh, IsAClosedConvexThinMeshWithManyRimTriangles) {
     }
   }
   EXPECT_LT(min_rim_spacing, 0.5 * kThickness_m);
+  // Edge flags: exactly the triangles more than 60° off the thin axis.
+  int edge = 0;
+  for (int i = 0; i < tool.node_count(); ++i) {
+    const bool rim = std::abs(tool.normals_tool()[static_cast<std::size_t>(i)].y()) < 0.5;
+    EXPECT_EQ(tool.edge_node_flags()[static_cast<std::size_t>(i)] != 0, rim);
+    edge += rim ? 1 : 0;
+  }
+  EXPECT_GT(edge, 0);
+  EXPECT_EQ(tool.edge_node_count(), edge);
 }
 
 // The paper's Fig. 2 problem and its fix: with an unlimited ray, rim nodes pair with nodes on the

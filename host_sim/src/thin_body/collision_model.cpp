@@ -87,7 +87,7 @@ CollisionModel build_collision_model(const ToolNodes& tool, const btSoftBody& so
   if (!(hc.k >= 0.0) || !(hc.lambda >= 0.0) || !(hc.n > 0.0) || !std::isfinite(hc.k) || !std::isfinite(hc.lambda) ||
       !std::isfinite(hc.n))
     throw std::invalid_argument("thin-body collision: Hunt-Crossley k, lambda >= 0 and n > 0 (finite)");
-  CollisionModel model{tool, build_bins(tool), SoftSurfaceModel{}, params, paired, 0.0};
+  CollisionModel model{tool, build_bins(tool), SoftSurfaceModel{}, params, paired, 0.0, {}};
   SoftSurfaceModel& surface = model.soft;
   surface.node_count = soft.m_nodes.size();
   surface.face_count = soft.m_faces.size();
@@ -112,6 +112,10 @@ CollisionModel build_collision_model(const ToolNodes& tool, const btSoftBody& so
   // A node already in contact may start a step this far behind its triangle (the soft solver
   // pushing a held node back a little) and still be in contact; further behind is another surface.
   model.memory_depth_m = std::max(tool.thickness_m(), 10.0 * params.contact_distance_m);
+  model.rim_plane.assign(tool.planes().size(), 0);
+  for (int i = 0; i < tool.node_count(); ++i)
+    if (tool.edge_node_flags()[static_cast<std::size_t>(i)] != 0)
+      model.rim_plane[static_cast<std::size_t>(tool.plane_of_node()[static_cast<std::size_t>(i)])] = 1;
   return model;
 }
 

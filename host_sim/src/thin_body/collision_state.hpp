@@ -51,6 +51,10 @@ struct CollisionModel {
   ThinBodyCollisionParams params;
   bool paired = true;          // false: the ray-only variant
   double memory_depth_m = 0.0; // how far behind a triangle a node already in contact may start
+  // Per tool plane: 1 when edge (rim) nodes lie on it (ToolNodes::edge_node_flags). A soft
+  // triangle placed on a rim plane takes ALL its free vertices onto that plane whenever the move
+  // does not pass through the tool (enforced_displacement.cpp).
+  std::vector<std::uint8_t> rim_plane;
 };
 
 // Per-step frame quantities.

@@ -7,7 +7,11 @@
 //  a. every vertex of a contacted triangle that is behind the leading node's tool plane is put
 //     on that plane (+ skin) — but only if it came from that plane's side: at the start of the
 //     step it was in front of the plane, or it was held on a plane facing the same way last step
-//     (soft-node side memory). So no vertex is ever moved THROUGH the tool;
+//     (soft-node side memory). So no vertex is ever moved THROUGH the tool. On a RIM plane (one
+//     carrying edge nodes: a side face of a blade) every free vertex whose straight move onto
+//     the plane does not pass through the tool is placed too — also one beside the blade and
+//     behind its rim: a coarse triangle straddling an edge-first blade is wrapped in front of the
+//     edge instead of being sliced (a rim has no opposite face to give a side memory);
 //  b. guard: every soft node near the tool whose relative path over the step (start → end, tool
 //     frame) enters the tool volume is put back on the plane it entered through (Cyrus–Beck
 //     clipping against the tool's convex planes); a node that starts inside (the soft solver
@@ -25,6 +29,7 @@
 
 #include <BulletSoftBody/btSoftBody.h>
 
+#include <algorithm>
 #include <limits>
 
 namespace fissure::host::thin_body {
@@ -80,6 +85,35 @@ struct Writer {
     return model.tool.planes()[static_cast<std::size_t>(data.hold_plane[n])].normal_tool.dot(normal) > kSameSideCosine;
   }
 
+  // Whether moving the node's end position straight onto `plane` (+ skin) along its normal stays
+  // outside the tool's interior (Cyrus–Beck clip of the move against every tool plane). A rim
+  // plane has no opposite face and no pair to say which side the soft body is on; geometry does:
+  // a vertex beside a blade (outside its slab), even behind the rim, is pulled onto the rim plane
+  // without passing through the tool, so a coarse triangle straddling the blade is wrapped in
+  // front of the edge instead of being sliced by it.
+  bool move_clears_tool(int node, const ToolPlane& target_plane) const {
+    const Eigen::Vector3d& a = data.end_tool_m[static_cast<std::size_t>(node)];
+    const double height = target_plane.normal_tool.dot(a);
+    const double lift = target_plane.offset_m + model.params.skin_m - height;
+    if (lift <= 0.0) return true;  // already in front: nothing to move
+    const Eigen::Vector3d b = a + lift * target_plane.normal_tool;
+    double t_enter = 0.0;
+    double t_exit = 1.0;
+    for (const ToolPlane& plane : model.tool.planes()) {
+      // Interior shrunk by the inside tolerance: touching a face or an edge is not "through".
+      const double fa = plane.normal_tool.dot(a) - plane.offset_m + kInsideTolerance_m;
+      const double fb = plane.normal_tool.dot(b) - plane.offset_m + kInsideTolerance_m;
+      if (fa >= 0.0 && fb >= 0.0) return true;  // the whole move is outside this plane
+      if (fa >= 0.0) {
+        t_enter = std::max(t_enter, fa / (fa - fb));
+      } else if (fb >= 0.0) {
+        t_exit = std::min(t_exit, fa / (fa - fb));
+      }
+      if (t_enter >= t_exit) return true;
+    }
+    return false;
+  }
+
   // A face with a colliding soft node enters the force set on the plane that node is held on (the
   // first colliding node found decides). A tool node that hit the face this step is kept as its
   // leading node only if it lies on that same plane.
@@ -102,7 +136,9 @@ struct Writer {
         if (fixed(node)) continue;
         const double start_height = plane.normal_tool.dot(data.start_tool_m[static_cast<std::size_t>(node)]);
         const bool came_from_front = start_height >= plane.offset_m - feasible_slack;
-        if (came_from_front || held_last_step_facing(node, plane.normal_tool)) place_on_plane(node, plane_index);
+        if (came_from_front || held_last_step_facing(node, plane.normal_tool) ||
+            (model.rim_plane[static_cast<std::size_t>(plane_index)] != 0 && move_clears_tool(node, plane)))
+          place_on_plane(node, plane_index);
       }
     }
   }

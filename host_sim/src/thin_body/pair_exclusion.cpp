@@ -24,6 +24,9 @@ namespace {
 
 // Two facing values / crossing times closer than this are treated as a tie.
 constexpr double kTie = 1e-9;
+// Facing difference (cosines) above which an edge node and a node on another plane are ranked by
+// facing rather than side memory: 0.25 ≈ 15° near head-on — a clear difference, not float noise.
+constexpr double kFacingMargin = 0.25;
 
 bool leads(const CollisionData& data, int i, int j) {
   const auto a = static_cast<std::size_t>(i);
@@ -32,6 +35,24 @@ bool leads(const CollisionData& data, int i, int j) {
   if (std::abs(data.node_facing[a] - data.node_facing[b]) > kTie) return data.node_facing[a] < data.node_facing[b];
   if (std::abs(data.node_tau[a] - data.node_tau[b]) > kTie) return data.node_tau[a] < data.node_tau[b];
   return i < j;
+}
+
+// Which of two non-excluded nodes that hit the same soft face places it on its plane. Between a
+// large-face node and an edge (rim) node on a different plane, the side memory (age) says nothing
+// — they are not the two sides of the thickness, the surface is at the tool's corner — so the node
+// that meets the triangle more head-on wins: a blade moving edge-first also touches the triangle
+// with the rim rows of both faces (grazing, facing ≈ 0), but the triangle belongs on the rim
+// plane (facing ≈ −1); a plate moving face-first reaches rim triangles with its face (≈ −1) while
+// its rim only grazes them. Otherwise (two face nodes, or no clear difference) the pair rule.
+bool places_face(const CollisionModel& model, const CollisionData& data, int i, int j) {
+  const auto& edge = model.tool.edge_node_flags();
+  const auto& plane_of_node = model.tool.plane_of_node();
+  const auto a = static_cast<std::size_t>(i);
+  const auto b = static_cast<std::size_t>(j);
+  if ((edge[a] != 0 || edge[b] != 0) && plane_of_node[a] != plane_of_node[b] &&
+      std::abs(data.node_facing[a] - data.node_facing[b]) > kFacingMargin)
+    return data.node_facing[a] < data.node_facing[b];
+  return leads(data, i, j);
 }
 
 bool in_contact(const CollisionData& data, int node) { return node >= 0 && data.node_face[static_cast<std::size_t>(node)] >= 0; }
@@ -82,7 +103,7 @@ int exclude_infeasible_pairs(const CollisionModel& model, CollisionData& data) {
       data.contacted_faces.push_back(face);
       data.face_lead_node[f] = i;
       data.face_plane[f] = plane_of_node[static_cast<std::size_t>(i)];
-    } else if (model.paired && leads(data, i, data.face_lead_node[f])) {
+    } else if (model.paired && places_face(model, data, i, data.face_lead_node[f])) {
       data.face_lead_node[f] = i;
       data.face_plane[f] = plane_of_node[static_cast<std::size_t>(i)];
     }

@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 
 #include <array>
+#include <cstdint>
 #include <vector>
 
 namespace fissure::host {
@@ -36,6 +37,12 @@ struct BoxToolShape {
   int thin_axis = 1;  // 0, 1, 2 in the tool frame
   int nodes_u = 9;    // grid resolution per large face along the first non-thin axis (≥ 1)
   int nodes_v = 9;    // ... along the second non-thin axis (≥ 1)
+  // Edge (rim) nodes on the four thin side faces, one row along the middle of the thickness at
+  // the large-face grid's positions along each side's long direction (nodes_v nodes on the two
+  // sides normal to u, nodes_u on the two normal to v). They are UNPAIRED and appended after the
+  // 2·nodes_u·nodes_v face nodes (which keep their indices). Without them a blade moving
+  // edge-first slips between the soft nodes of a coarse mesh and slices it without any force.
+  bool edge_nodes = true;
 };
 
 // A convex thin tool given as a closed triangle mesh in the tool frame (outward winding, i.e.
@@ -84,6 +91,13 @@ class ToolNodes {
   [[nodiscard]] const std::vector<int>& plane_of_node() const { return plane_of_node_; }
   [[nodiscard]] const std::vector<ToolPlane>& planes() const { return planes_; }
   [[nodiscard]] const PairingReport& pairing_report() const { return report_; }
+  // 1 for an edge (rim) node: a node on a side face, not on one of the two large faces (box: the
+  // appended side-face rows; mesh: centroids of triangles whose normal is more than 60° off the
+  // thin axis). Edge nodes are never paired on a box. When an edge node and a node on another
+  // tool plane hit the same soft triangle, the one meeting it more head-on places it (see
+  // pair_exclusion.cpp).
+  [[nodiscard]] const std::vector<std::uint8_t>& edge_node_flags() const { return edge_node_; }
+  [[nodiscard]] int edge_node_count() const;
   // Whether pairing (and so the infeasible-pair exclusion) applies: box tools always, meshes
   // when pairing_ray_limit_m > 0 and at least one pair was found.
   [[nodiscard]] bool is_thin() const { return thin_; }
@@ -112,6 +126,7 @@ class ToolNodes {
   std::vector<int> paired_by_begin_;
   std::vector<int> paired_by_nodes_;
   std::vector<int> plane_of_node_;
+  std::vector<std::uint8_t> edge_node_;
   std::vector<ToolPlane> planes_;
   std::vector<Eigen::Vector3d> hull_vertices_tool_m_;
   // Footprint along the thin axis as 2-D half-planes (a·(u,v) ≤ b) of the projected hull.
