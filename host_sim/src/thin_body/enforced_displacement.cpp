@@ -39,6 +39,9 @@ namespace {
 constexpr double kInsideTolerance_m = 1e-7;
 // Two tool planes "face the same way" (a node held on one may be moved to the other) above this cosine.
 constexpr double kSameSideCosine = 0.5;
+// A rim node "leads into" a soft triangle when it meets it within 60° of head-on (tool normal ·
+// soft normal < −0.5); below that it is grazing it.
+constexpr double kRimHeadOnCosine = 0.5;
 
 struct Writer {
   const CollisionModel& model;
@@ -132,12 +135,18 @@ struct Writer {
     for (const int face : data.contacted_faces) {
       const int plane_index = data.face_plane[static_cast<std::size_t>(face)];
       const ToolPlane& plane = model.tool.planes()[static_cast<std::size_t>(plane_index)];
+      // Wrapping applies when the rim LEADS into the triangle (its node meets it head-on, as an
+      // edge-first blade does); a rim node grazing a triangle at the side of a plate moving
+      // face-first must not drag the vertices under the plate sideways onto its rim plane.
+      const int lead = data.face_lead_node[static_cast<std::size_t>(face)];
+      const bool rim_leads = model.rim_plane[static_cast<std::size_t>(plane_index)] != 0 && lead >= 0 &&
+                             data.node_facing[static_cast<std::size_t>(lead)] < -kRimHeadOnCosine;
       for (const int node : model.soft.face_nodes[static_cast<std::size_t>(face)]) {
         if (fixed(node)) continue;
         const double start_height = plane.normal_tool.dot(data.start_tool_m[static_cast<std::size_t>(node)]);
         const bool came_from_front = start_height >= plane.offset_m - feasible_slack;
         if (came_from_front || held_last_step_facing(node, plane.normal_tool) ||
-            (model.rim_plane[static_cast<std::size_t>(plane_index)] != 0 && move_clears_tool(node, plane)))
+            (rim_leads && move_clears_tool(node, plane)))
           place_on_plane(node, plane_index);
       }
     }
