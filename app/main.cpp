@@ -11,6 +11,7 @@
 #include "device_kinematics.hpp"
 #include "device_usb.hpp"
 #include "sim_command.hpp"
+#include "bench_collision.hpp"
 #include "run_command.hpp"
 
 namespace {
@@ -53,6 +54,7 @@ int main(int argc, char** argv) {
   fissure::app::register_device_kinematics(tree);
   fissure::app::register_bench_kinematics(tree);
   fissure::app::register_sim(tree);
+  fissure::app::register_bench_collision(tree);
   fissure::app::register_run(tree);
   fissure::app::register_bench_rt(tree);
 

@@ -29,6 +29,13 @@ namespace {
 // edges round off, like the convex spatula's rim).
 constexpr double kToolShapeMarginRatio = 0.9;
 
+// When only the ground meets the soft body through Bullet (paired / ray), the SDF only has
+// to represent a flat box face, which trilinear interpolation reproduces exactly at any
+// voxel size; a 1 cm voxel keeps the number of lazily built cells (each a GJK query per
+// corner) small. Measured: with the 1 mm tool voxel a 5120-face ball pressed on the ground
+// spent ~2 ms per step building ground cells.
+constexpr double kGroundOnlyVoxelM = 0.01;
+
 btVector3 bt(const Vec3& v) { return {static_cast<btScalar>(v[0]), static_cast<btScalar>(v[1]), static_cast<btScalar>(v[2])}; }
 btVector3 bt(const Eigen::Vector3d& v) { return {static_cast<btScalar>(v.x()), static_cast<btScalar>(v.y()), static_cast<btScalar>(v.z())}; }
 
@@ -116,7 +123,7 @@ SoftWorld::SoftWorld(const SceneDescription& scene, bool tool_collides_in_bullet
   info.m_dispatcher = dispatcher_.get();
   info.m_broadphase = broadphase_.get();
   // Initialize() forces a 0.25 m voxel; the fair baseline needs ~half the tool thickness.
-  sdf_voxel_m_ = 0.5 * geometry_.thickness_m;
+  sdf_voxel_m_ = tool_collides_in_bullet ? 0.5 * geometry_.thickness_m : kGroundOnlyVoxelM;
   info.m_sparsesdf.Initialize();
   info.m_sparsesdf.setDefaultVoxelsz(static_cast<btScalar>(sdf_voxel_m_));
   info.m_sparsesdf.Reset();

@@ -5,9 +5,10 @@
 // soft body through Bullet ONLY for the `bullet` method; for paired/ray they are not in the
 // world at all (thin_body_collision.hpp's call order) and the soft body meets just the ground.
 //
-// Bullet set-up shared by all methods (BRIEF §3): the sparse SDF's voxel is set to half the
-// tool's thinnest extent AFTER Initialize() (which forces 0.25 m), then Reset(); soft margin
-// from the scene; kKHR = kCHR = 1 (soft_body_builder).
+// Bullet set-up (BRIEF §3): for the `bullet` method the sparse SDF's voxel is set to half the
+// tool's thinnest extent AFTER Initialize() (which forces 0.25 m), then Reset(), and the tool
+// shape's margin is 0.9 × its half thickness (soft_world.cpp says why); otherwise (only the
+// flat ground in Bullet) a 1 cm voxel. Soft margin from the scene; kKHR = kCHR = 1.
 #include <array>
 #include <memory>
 #include <vector>
