@@ -122,6 +122,14 @@ INSTANTIATE_TEST_SUITE_P(
 // triangle cut by the tool's interior at the end.
 class EdgeFirstPlunge : public ::testing::TestWithParam<PlungeCase> {};
 
+// Order statistic of wall-clock samples (for the printed step times).
+double percentile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  return values[static_cast<std::size_t>(q * static_cast<double>(values.size() - 1))];
+}
+
+
 PlungeSpec edge_first_spec(double speed) {
   PlungeSpec spec;
   spec.speed_m_s = speed;
@@ -140,10 +148,11 @@ TEST_P(EdgeFirstPlunge, TheRimPushesTheSurfaceInAtAnySpeed) {
   const PlungeOutcome out = test_scene::run_sphere_plunge(tool, CollisionMethod::kPaired, edge_first_spec(c.speed_m_s));
   std::printf("[edge-first] %-15s %5.1f m/s: crossed %d, max penetration %.4f mm, F_y on arrival at 5 mm %.3f N, max F_y at "
               "5 mm %.3f N (end of hold %.3f N, max |F| over run %.3f N), rim %.2f mm into the soft top, triangles cut at end "
-              "%d (max over run %d, deepest %.2e m)\n",
+              "%d (max over run %d, deepest %.2e m), step time median %.1f us p99 %.1f us\n",
               tool_name(c.tool).c_str(), c.speed_m_s, out.crossed_nodes, out.max_penetration_m * 1e3, out.force_y_at_arrival_n,
               out.max_force_y_at_end_n, out.final_force_y_n, out.max_force_n, (out.soft_top_start_m - out.tool_bottom_end_m) * 1e3, out.triangles_cut_end,
-              out.max_triangles_cut, out.deepest_triangle_point_end_m);
+              out.max_triangles_cut, out.deepest_triangle_point_end_m, percentile(out.step_seconds, 0.5) * 1e6,
+              percentile(out.step_seconds, 0.99) * 1e6);
   EXPECT_NEAR(out.soft_top_start_m - out.tool_bottom_end_m, 0.005, 1e-9);
   EXPECT_EQ(out.crossed_nodes, 0);
   EXPECT_LE(out.max_penetration_m, 1e-4);
@@ -192,12 +201,6 @@ TEST(PairedCollision, WithoutEdgeNodesTheEdgeFirstBladeSlicesTheSphere) {
 // same force to within 10 % (only the rim rows add contacts, at the plate's sides), never more
 // soft triangles cut by the plate's rim. Also prints the collision step time (wall clock,
 // in-contact steps; informative, not asserted).
-double percentile(std::vector<double> values, double q) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  return values[static_cast<std::size_t>(q * static_cast<double>(values.size() - 1))];
-}
-
 TEST(PairedCollision, EdgeNodesLeaveTheFaceFirstPlungeUnchanged) {
   for (const double thickness : {0.004, 0.001}) {
     BoxToolShape shape;
