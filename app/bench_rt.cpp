@@ -415,7 +415,8 @@ nlohmann::json cyclictest_json(const CyclictestResult& c) {
   if (!c.available) return {{"available", false}, {"reason", c.reason}, {"command", c.command}};
   return {{"available", true},     {"median", c.quantile_us(0.5)}, {"p99", c.quantile_us(0.99)},
           {"p999", c.quantile_us(0.999)}, {"max", c.max_us},            {"samples", c.samples},
-          {"overflows", c.overflows}, {"command", c.command}};
+          {"overflows", c.overflows}, {"command", c.command},
+          {"overruns", nullptr}};  // cyclictest does not count missed periods
 }
 
 // ---------------------------------------------------------------- 3. Z-width
