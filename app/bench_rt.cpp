@@ -522,6 +522,8 @@ struct Arguments {
 };
 
 void run(const Arguments& args) {
+  // Fail before a minute of measuring, not after, when the output cannot be written.
+  if (!std::ofstream(args.json_path)) throw CommandError("cannot write --json file '" + args.json_path + "'");
   nlohmann::json out;
   out["benchmark"] = "rt";
   out["machine"] = machine_info();
