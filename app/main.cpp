@@ -13,6 +13,7 @@
 #include "sim_command.hpp"
 #include "bench_collision.hpp"
 #include "run_command.hpp"
+#include "bench_proxy.hpp"
 
 namespace {
 
@@ -56,6 +57,7 @@ int main(int argc, char** argv) {
   fissure::app::register_sim(tree);
   fissure::app::register_bench_collision(tree);
   fissure::app::register_run(tree);
+  fissure::app::register_bench_proxy(tree);
   fissure::app::register_bench_rt(tree);
 
   if (const std::string unknown = unknown_subcommand(root, argc, argv); !unknown.empty()) {

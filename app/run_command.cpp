@@ -21,7 +21,7 @@ namespace {
 std::atomic<bool> g_interrupt{false};
 static_assert(std::atomic<bool>::is_always_lock_free, "set from a signal handler");
 
-extern "C" void on_sigint(int /*signal*/) {
+void on_run_sigint(int /*signal*/) {
   g_interrupt.store(true, std::memory_order_relaxed);
   std::signal(SIGINT, SIG_DFL);  // the second Ctrl-C ends the process at once
 }
@@ -60,7 +60,7 @@ void run(const RunOptions& options) {
   g_interrupt.store(false);
   session.interrupt = &g_interrupt;
   struct sigaction action {};
-  action.sa_handler = on_sigint;
+  action.sa_handler = on_run_sigint;
   sigemptyset(&action.sa_mask);
   struct sigaction previous {};
   sigaction(SIGINT, &action, &previous);

@@ -64,7 +64,8 @@ void SessionRecorder::add_host_step(const HostStatus& host) {
 
 void SessionRecorder::add_tick(const rt::TelemetrySample& s, const HostStatus& host) {
   last_ = s;
-  ++figures_.telemetry_samples;
+  if (figures_.telemetry_samples++ == 0) figures_.first_tick_time_ns = s.time_ns;
+  figures_.last_tick_time_ns = s.time_ns;
   figures_.ticks = s.tick + 1;
   figures_.overruns = s.overruns;
   const std::uint32_t faults = s.fault_bits & rt::kAnyFault;
@@ -82,7 +83,7 @@ void SessionRecorder::add_tick(const rt::TelemetrySample& s, const HostStatus& h
   if (trace_ != nullptr) {
     std::fprintf(trace_,
                  "%.6f,%llu,%.7g,%.7g,%.7g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%u,%.4f,%llu,%.6g,%.4g,%.4g,%u,%llu,%.6f,%.6g,%d,%d,%.6g\n",
-                 static_cast<double>(s.time_ns) * 1e-9, static_cast<unsigned long long>(s.tick), s.tool_position_world_m[0],
+                 static_cast<double>(s.time_ns - figures_.first_tick_time_ns) * 1e-9, static_cast<unsigned long long>(s.tick), s.tool_position_world_m[0],
                  s.tool_position_world_m[1], s.tool_position_world_m[2], s.jaw_closing_m, s.force_device_n[0],
                  s.force_device_n[1], s.force_device_n[2], force, contact_force, std::max(0.0, s.max_penetration_m),
                  static_cast<unsigned>(s.patches_in_contact), age_ms, static_cast<unsigned long long>(s.proxy_sequence),

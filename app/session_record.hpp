@@ -22,6 +22,8 @@ struct SessionFigures {
   std::uint64_t fault_ticks = 0;           ///< ticks with any RtFaultBits fault bit set
   std::uint32_t fault_bits_seen = 0;       ///< OR of every fault bit seen
   std::uint64_t telemetry_samples = 0;
+  TimeNs first_tick_time_ns = 0;           ///< loop clock time of the first / last sample
+  TimeNs last_tick_time_ns = 0;
   double force_max_n = 0.0;                ///< max |commanded device force|
   double contact_force_max_n = 0.0;        ///< max |proxy force| before passivity/safety
   double rt_penetration_max_m = 0.0;       ///< deepest proxy penetration rt_core evaluated
