@@ -13,6 +13,9 @@
 #include "sim_command.hpp"
 #include "bench_collision.hpp"
 #include "run_command.hpp"
+#include "rt_command.hpp"
+#include "host_command.hpp"
+#include "hil_latency.hpp"
 #include "bench_proxy.hpp"
 
 namespace {
@@ -57,6 +60,9 @@ int main(int argc, char** argv) {
   fissure::app::register_sim(tree);
   fissure::app::register_bench_collision(tree);
   fissure::app::register_run(tree);
+  fissure::app::register_rt_command(tree);
+  fissure::app::register_host_command(tree);
+  fissure::app::register_hil_latency(tree);
   fissure::app::register_bench_proxy(tree);
   fissure::app::register_bench_rt(tree);
 
