@@ -7,7 +7,24 @@ namespace fissure::app {
 
 LinkBridge::LinkBridge(transport::FrameCarrier& carrier, const Clock& clock, const transport::LinkConfig& config,
                        TimeNs peer_silent_after_ns) noexcept
-    : clock_(clock), role_(config.role), peer_silent_after_ns_(peer_silent_after_ns), endpoint_(carrier, clock, config) {}
+    : clock_(clock),
+      role_(config.role),
+      peer_silent_after_ns_(peer_silent_after_ns),
+      hello_period_ns_(config.hello_period_ns),
+      endpoint_(carrier, clock, config),
+      announcer_(carrier) {}
+
+void LinkBridge::announce_while_silent() noexcept {
+  if (!endpoint_.established() || !peer_silent()) return;
+  const TimeNs now_ns = clock_.now();
+  if (announcements_ != 0 && now_ns - last_announce_ns_ < hello_period_ns_) return;
+  // Hellos are one frame and not tracked by transfer id, so a second sender on the carrier
+  // cannot confuse the peer's reassembly of the endpoint's messages.
+  announcer_.publish(endpoint_.handshake().hello());
+  announcer_.service();
+  last_announce_ns_ = now_ns;
+  ++announcements_;
+}
 
 void LinkBridge::note_restart() noexcept {
   if (!endpoint_.established()) return;
@@ -39,6 +56,7 @@ void LinkBridge::pump_rt(rt::DeviceStateExchange& from_rt, rt::ProxyExchange& to
   }
   // Send in the same pump what was just queued (tick() sent before the publish).
   endpoint_.tick();
+  announce_while_silent();
 }
 
 void LinkBridge::pump_host(rt::DeviceStateExchange& to_host, rt::ProxyExchange& from_host) noexcept {
@@ -52,6 +70,7 @@ void LinkBridge::pump_host(rt::DeviceStateExchange& to_host, rt::ProxyExchange& 
     if (endpoint_.publish(proxy_scratch_) == wire::EncodeStatus::kOk) ++messages_out_;
   }
   endpoint_.tick();
+  announce_while_silent();
 }
 
 TimeNs LinkBridge::peer_data_age_ns() const noexcept {
@@ -75,6 +94,7 @@ BridgeStatus LinkBridge::status() const noexcept {
   out.messages_discarded = wire_stats.messages_discarded() + endpoint_.receiver().stats().data_before_handshake;
   out.peer_restarts = peer_restarts_;
   out.carrier_errors = endpoint_.receiver().stats().carrier_errors + endpoint_.sender().stats().messages_send_failed;
+  out.announcements = announcements_;
   return out;
 }
 

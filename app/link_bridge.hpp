@@ -9,6 +9,10 @@
 // Peer death: the rt end needs nothing from the bridge — no proxy is forwarded, rt_core's
 // staleness stage fades the force to zero (ProxyConfig: stale 0.1 s + fade 0.05 s). The host
 // end asks peer_silent() before each step and pauses the scene while rt_core is silent.
+// While the peer is silent the bridge keeps announcing itself (a Hello every hello period):
+// the LinkEndpoint stops sending Hellos once acknowledged, and a paused host sends no data,
+// so without this a restarted rt end (UDP: it binds and answers whoever talks to it) would
+// never learn the host's address and the link would not come back.
 // pump_*() are noexcept and allocation-free (the LinkEndpoint is), so a bridge could share a
 // thread with anything.
 #include <cstdint>
@@ -44,6 +48,7 @@ struct BridgeStatus {
   std::uint64_t messages_discarded = 0;  ///< reassembler message-level discards + data before handshake
   std::uint64_t peer_restarts = 0;       ///< the peer came back with a new session id
   std::uint64_t carrier_errors = 0;      ///< send + receive failures the carrier reported
+  std::uint64_t announcements = 0;       ///< Hellos sent while the established peer was silent
 };
 
 class LinkBridge {
@@ -76,11 +81,16 @@ class LinkBridge {
 
  private:
   void note_restart() noexcept;
+  void announce_while_silent() noexcept;
 
   const Clock& clock_;
   wire::Role role_;
   TimeNs peer_silent_after_ns_;
+  TimeNs hello_period_ns_;
   transport::LinkEndpoint endpoint_;
+  transport::LinkSender announcer_;  ///< Hellos while the peer is silent (the endpoint has stopped)
+  TimeNs last_announce_ns_ = 0;
+  std::uint64_t announcements_ = 0;
   std::uint64_t messages_in_ = 0;
   std::uint64_t messages_out_ = 0;
   std::uint64_t peer_restarts_ = 0;
