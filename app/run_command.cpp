@@ -36,6 +36,7 @@ struct RunOptions {
   double settle_s = 1.0;
   std::string out_dir;
   bool no_plot = false;
+  bool no_passivity_controller = false;
   bool quiet = false;
 };
 
@@ -56,6 +57,7 @@ void run(const RunOptions& options) {
   session.settle_s = options.settle_s;
   session.out_dir = options.out_dir.empty() ? std::filesystem::path("out") / ("run-" + scene.name) : std::filesystem::path(options.out_dir);
   session.plot = !options.no_plot;
+  session.passivity_controller = !options.no_passivity_controller;
   session.status_line = !options.quiet;
   g_interrupt.store(false);
   session.interrupt = &g_interrupt;
@@ -108,6 +110,8 @@ void register_run(CommandTree& tree) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--out", options->out_dir, "output directory (default out/run-SCENE)");
   cmd->add_flag("--no-plot", options->no_plot, "skip the PNG plot");
+  cmd->add_flag("--no-passivity-controller", options->no_passivity_controller,
+                "diagnosis: rt_core's passivity controller off (the energy observer still runs)");
   cmd->add_flag("--quiet", options->quiet, "no status line");
   cmd->callback([options] { run(*options); });
 }

@@ -172,6 +172,7 @@ SessionOutcome run_session(const SessionOptions& options) {
   rt::RtConfig config;
   config.rate_hz = options.rt_rate_hz;
   config.mapping = scene.device_mapping;
+  config.passivity.enabled = options.passivity_controller;
   rt::RtModel model;
   const char* config_error = nullptr;
   if (!rt::build_model(config, model, &config_error)) throw CommandError(std::string("rt config: ") + config_error);
@@ -347,6 +348,7 @@ SessionOutcome run_session(const SessionOptions& options) {
   summary["proxy_age_ms"] = quantile_json(std::move(ages));
   summary["energy_j"] = f.energy_j;
   summary["energy_max_j"] = f.energy_max_j;
+  summary["passivity_controller"] = options.passivity_controller;
   summary["contact_depth_max_mm"] = f.rt_penetration_max_m * 1e3;
   summary["host_penetration_max_mm"] = f.host_penetration_max_m * 1e3;
   summary["host_steps"] = f.host_steps;

@@ -37,6 +37,9 @@ struct SessionOptions {
   double settle_s = 1.0;
   std::filesystem::path out_dir;
   bool plot = true;
+  /// rt_core's passivity controller (the observer always runs). Off only to diagnose where
+  /// energy comes from: with it off the summary's energy_j is the rendered contact's own.
+  bool passivity_controller = true;
   bool status_line = true;
   /// Set from a signal handler: ramp out and stop (checked ~every 10 ms in real time, every
   /// host step in lockstep).
