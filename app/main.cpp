@@ -13,6 +13,8 @@
 #include "sim_command.hpp"
 #include "bench_collision.hpp"
 #include "run_command.hpp"
+#include "render_command.hpp"
+#include "bench_view.hpp"
 #include "rt_command.hpp"
 #include "host_command.hpp"
 #include "hil_latency.hpp"
@@ -65,6 +67,8 @@ int main(int argc, char** argv) {
   fissure::app::register_hil_latency(tree);
   fissure::app::register_bench_proxy(tree);
   fissure::app::register_bench_rt(tree);
+  fissure::app::register_render(tree);
+  fissure::app::register_bench_view(tree);
 
   if (const std::string unknown = unknown_subcommand(root, argc, argv); !unknown.empty()) {
     std::fprintf(stderr, "fissure: error: %s (see 'fissure --help')\n", unknown.c_str());

@@ -13,6 +13,7 @@ packages=(
   libeigen3-dev libbullet-dev libgtest-dev libgmock-dev libbenchmark-dev
   libusb-1.0-0-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libspdlog-dev
   libtinyobjloader-dev
+  libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libglfw3-dev libpng-dev  # viewer/: headless EGL (llvmpipe), GL 3.3, GLFW window, PNG
   # session plot (Debian's interpreter, not whatever python3 is first on PATH)
   python3 python3-matplotlib
   # cyclictest, the OS-latency reference of `fissure bench rt`
