@@ -318,6 +318,7 @@ void read_soft_body(TableReader& t, SoftBodyDescription& soft) {
   soft.linear_stiffness_ratio = t.in_range("linear_stiffness", "ratio", 1e-6, 1.0);
   soft.pressure_kpr = t.in_range("pressure", "kpr", 0.0, 1e9);
   soft.volume_conservation_kvc = t.in_range("volume_conservation", "kvc", 0.0, 1e9);
+  soft.shape_matching_ratio = t.in_range("shape_matching", "ratio", 0.0, 1.0, 0.0);
   soft.damping_ratio = t.in_range("damping", "ratio", 0.0, 1.0);
   soft.friction_ratio = t.in_range("friction", "ratio", 0.0, 1.0);
   soft.position_iterations_count = t.count("position_iterations", 1, 1000);

@@ -186,7 +186,10 @@ btSoftBody* build_soft_body(btSoftBodyWorldInfo& world_info, const SoftBodyDescr
   body->getCollisionShape()->setMargin(static_cast<btScalar>(d.collision_margin_m));
   body->setTotalMass(static_cast<btScalar>(d.mass_kg), false);
   for (int i : pinned) body->setMass(i, 0);
-  if (d.volume_conservation_kvc > 0.0) body->setPose(true, false);
+  body->m_cfg.kMT = static_cast<btScalar>(d.shape_matching_ratio);
+  // setPose records the rest shape: its volume for kVC, its node frame for kMT (pose matching).
+  if (d.volume_conservation_kvc > 0.0 || d.shape_matching_ratio > 0.0)
+    body->setPose(d.volume_conservation_kvc > 0.0, d.shape_matching_ratio > 0.0);
   body->setActivationState(DISABLE_DEACTIVATION);
   return body;
 }

@@ -137,6 +137,15 @@ TEST(SceneLoader, OutOfRangeValueNamesField) {
   expect_error(load_error(bad_method), line_of(bad_method, "collision_method"), "simulation.collision_method", "not one of");
 }
 
+TEST(SceneLoader, ShapeMatchingIsOptionalAndRangeChecked) {
+  const std::string good = read(kScenes / "spatula-sphere.toml");
+  EXPECT_EQ(load_scene_text(good, "good.toml", kScenes).soft_body.shape_matching_ratio, 0.0);
+  const std::string with = replace(good, "damping_ratio = 0.02", "damping_ratio = 0.02\nshape_matching_ratio = 0.05");
+  EXPECT_EQ(load_scene_text(with, "good.toml", kScenes).soft_body.shape_matching_ratio, 0.05);
+  const std::string bad = replace(good, "damping_ratio = 0.02", "damping_ratio = 0.02\nshape_matching_ratio = 1.5");
+  expect_error(load_error(bad), line_of(bad, "shape_matching_ratio"), "soft_body.shape_matching_ratio", "must be in");
+}
+
 TEST(SceneLoader, UnreadableMeshNamesMeshPath) {
   const std::string good = read(kScenes / "convex-spatula-sphere.toml");
   const std::string missing = replace(good, "meshes/convex-spatula.obj", "meshes/no-such-mesh.obj");

@@ -57,7 +57,18 @@ void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, co
     data.hc_x_prev_m[f] = x;
     data.hc_rate_filtered_m_s[f] = rate_filtered;
 
-    const double weight = hc.per_unit_area ? model.soft.rest_area_m2[f] : 1.0;
+    // Per unit area the sum is a quadrature of k·xⁿ over the contacted surface. A triangle at the
+    // rim of the patch has only some vertices on the tool: counting its whole area there adds a
+    // ring one edge wide (an O(h) error — with the whole area, 1280/5120/20480 faces gave
+    // 1.47/1.25/1.19 N at 4 mm). Its contacted share is taken as the fraction of its vertices
+    // that are colliding (the contact indicator interpolated linearly over the triangle).
+    double contacted_share = 1.0;
+    if (hc.per_unit_area) {
+      int colliding = 0;
+      for (const int node : model.soft.face_nodes[f]) colliding += data.moved_stamp[static_cast<std::size_t>(node)] == frame.step ? 1 : 0;
+      contacted_share = colliding / 3.0;
+    }
+    const double weight = hc.per_unit_area ? contacted_share * model.soft.rest_area_m2[f] : 1.0;
     const double x_pow_n = std::pow(x, hc.n);
     const double force = std::max(0.0, weight * (hc.k * x_pow_n + hc.lambda * x_pow_n * rate_filtered));
     const int plane_index = data.face_plane[f];

@@ -64,6 +64,9 @@ struct SoftBodyDescription {
   double linear_stiffness_ratio = 0.5;     ///< Bullet material kLST ∈ (0, 1]
   double pressure_kpr = 0.0;               ///< Bullet config kPR (pressure coefficient), ≥ 0
   double volume_conservation_kvc = 0.0;    ///< Bullet config kVC, ≥ 0
+  /// Bullet config kMT ∈ [0, 1]: pose (shape) matching towards the rest shape, the only
+  /// restoring force a pressure-less edge-link shell has against being dented (0: off).
+  double shape_matching_ratio = 0.0;
   double damping_ratio = 0.01;             ///< Bullet config kDP ∈ [0, 1]
   double friction_ratio = 0.2;             ///< Bullet config kDF ∈ [0, 1]
   int position_iterations_count = 4;       ///< Bullet config piterations

@@ -29,8 +29,9 @@ struct HuntCrossleyParams {
   double k = 2.0e5;       // per_unit_area: N/m^(n+2) (× rest area m² → N/mⁿ); else N/mⁿ per triangle
   double lambda = 50.0;   // per_unit_area: N·s/m^(n+3); else N·s/m^(n+1) per triangle
   double n = 1.5;         // exponent (1 flat punch, 3/2 Hertz)
-  // true (default): k and λ per unit area, each triangle weighted by its rest area, so refining the
-  // mesh converges the force; false: the paper's plain per-triangle sum.
+  // true (default): k and λ per unit area, each triangle weighted by its contacted share of its rest
+  // area (rest area × colliding vertices / 3), so refining the mesh converges the force; false:
+  // the paper's plain per-triangle sum.
   bool per_unit_area = true;
 };
 
@@ -67,7 +68,8 @@ struct ContactRecord {
   Eigen::Vector3d normal_world = Eigen::Vector3d::Zero();    // tool face outward normal (world)
   double penetration_m = 0.0;         // HC deformation x: |centroid − rest centroid|
   double penetration_rate_m_s = 0.0;  // filtered ẋ
-  double weight = 1.0;                // rest area (m²) in per-unit-area mode, 1 otherwise
+  double weight = 1.0;                // per-unit-area mode: contacted share of the rest area (m²) = rest
+                                      // area × (colliding vertices / 3); 1 otherwise
   double force_n = 0.0;               // this triangle's HC force magnitude (≥ 0)
 };
 
