@@ -113,7 +113,12 @@ CrossingSnapshot CrossingTracker::update(const std::vector<Eigen::Vector3d>& sof
     snap.max_penetration_m = std::max(snap.max_penetration_m, penetration_m);
     const bool inside = penetration_m > kInsideToleranceM;
     bool wrong_side = false;
-    if (volume_.in_footprint(p)) {
+    // Beside the rim: outside the tool but within its thickness band. The footprint's edge and
+    // the tool's side face are the same line, so a node held on a side face (the paired method
+    // leaves it skin_m outside) projects onto the footprint's edge within rounding and may
+    // slide past the mid-plane along the face — that is going round the rim, not through.
+    const bool beside_rim = !inside && penetration_m == 0.0 && std::abs(p.y()) < volume_.half_thickness_m();
+    if (volume_.in_footprint(p) && !beside_rim) {
       if (side_[i] == 0) side_[i] = side_now;  // first seen exactly on the mid-plane
       wrong_side = side_now != 0 && side_now != side_[i];
     } else if (side_now != 0) {

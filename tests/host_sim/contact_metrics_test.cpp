@@ -79,6 +79,24 @@ TEST(CrossingTracker, GoingRoundTheRimIsNotCrossing) {
   EXPECT_EQ(tracker.sides()[0], 1);
 }
 
+TEST(CrossingTracker, SlidingAlongASideFaceIsNotCrossing) {
+  // The paired method holds a node on a side (rim) face; its projection is then on the
+  // footprint's edge, and it may slide past the mid-plane along the face (bench collision:
+  // convex spatula at 2 m/s reported 1 wrong-side node that was exactly this).
+  CrossingTracker tracker(ToolVolume::from_box(kPlateHalf_m), 1);
+  std::vector<Eigen::Vector3d> node = {{0.0, -0.01, 0.0}};
+  tracker.reset(node, at(0, 0, 0));
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(0.02, -0.001, 0), Eigen::Vector3d(0.02, 0.001, 0), Eigen::Vector3d(0.0, 0.01, 0)}) {
+    node[0] = p;
+    EXPECT_EQ(tracker.update(node, at(0, 0, 0)).crossed_nodes, 0) << p.transpose();
+  }
+  // Just inside the side face it is inside the plate, where the memory stays frozen.
+  node[0] = {0.0, -0.01, 0.0};
+  tracker.reset(node, at(0, 0, 0));
+  node[0] = {0.0199, 0.001, 0.0};
+  EXPECT_EQ(tracker.update(node, at(0, 0, 0)).wrong_side_nodes, 1);
+}
+
 TEST(CrossingTracker, PenetrationAndInsideTolerance) {
   CrossingTracker tracker(ToolVolume::from_box(kPlateHalf_m), 2);
   std::vector<Eigen::Vector3d> nodes = {{0.0, -0.01, 0.0}, {0.01, -0.01, 0.0}};

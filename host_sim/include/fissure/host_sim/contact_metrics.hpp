@@ -8,7 +8,8 @@
 // * footprint: the tool's silhouette seen along the thin axis (convex polygon in x–z).
 // * side memory: each soft node remembers the side of the mid-plane it is on (sign of
 //   y_tool). The memory follows the node freely while it is OUTSIDE the footprint (it may
-//   go around the rim); inside the footprint it is frozen.
+//   go around the rim); inside the footprint it is frozen — except beside the rim (outside
+//   the tool, |y_tool| < half thickness: a node on a side face), where it also follows.
 // * wrong side: the node is inside the footprint and on the other side of the mid-plane
 //   than it remembers — it went through the tool.
 // * inside: the node lies inside the tool volume deeper than kInsideToleranceM.
