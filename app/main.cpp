@@ -19,6 +19,7 @@
 #include "host_command.hpp"
 #include "hil_latency.hpp"
 #include "bench_proxy.hpp"
+#include "stress_command.hpp"
 
 namespace {
 
@@ -69,6 +70,7 @@ int main(int argc, char** argv) {
   fissure::app::register_bench_rt(tree);
   fissure::app::register_render(tree);
   fissure::app::register_bench_view(tree);
+  fissure::app::register_stress(tree);
 
   if (const std::string unknown = unknown_subcommand(root, argc, argv); !unknown.empty()) {
     std::fprintf(stderr, "fissure: error: %s (see 'fissure --help')\n", unknown.c_str());
