@@ -1,8 +1,9 @@
 // `fissure bench view [--scene S] [--repeats N] [--json FILE]`: host step time with nothing
 // drawn, with snapshots captured and published into an exchange nobody reads (the bare cost of
 // the hand-off), with the frame writer thread running (every 10 steps and every step, never
-// waited for), and with the --view window when a display exists. The host step never waits for
-// a view; what is left is competition for the CPU (2 cores here; llvmpipe renders on the CPU).
+// waited for), and with the --view window when a display exists — every row paced at the scene's
+// real host rate, as in a session. The host step never waits for a view; what is left is
+// competition for the CPU (2 cores here; llvmpipe renders on the CPU).
 #include "bench_view.hpp"
 
 #include <cstdio>
@@ -45,8 +46,8 @@ void run_bench(const BenchViewOptions& o) {
   if (display != nullptr && *display != '\0') configs.push_back({"view window", false, 0, true});
   nlohmann::json rows = nlohmann::json::array();
   std::printf("bench view: scene %s, scripted trajectory, %d repeats per row\n", o.scene.c_str(), o.repeats);
-  std::printf("%-22s %12s %10s %14s %12s %9s %9s %9s\n", "configuration", "step med us", "p99 us", "publish med us", "p99 us",
-              "frames", "dropped", "frame ms");
+  std::printf("%-22s %12s %10s %14s %12s %9s %9s %9s %11s\n", "configuration", "step med us", "p99 us", "publish med us", "p99 us",
+              "frames", "dropped", "frame ms", "view frames");
   for (const Config& c : configs) {
     std::vector<double> step_s, publish_s, frame_s;
     std::uint64_t written = 0, dropped = 0, view_frames = 0;
@@ -56,13 +57,13 @@ void run_bench(const BenchViewOptions& o) {
       ro.quiet = true;
       ro.publish_only = c.publish_only;
       ro.view = c.view;
-      ro.realtime = false;
+      ro.realtime = true;  // every row at the host's real rate (1 kHz), as in a session
+      ro.hold_view_at_end = false;
       if (c.frame_every > 0) {
         ro.frames_dir = o.frames_dir;
         ro.frame_every = c.frame_every;
         ro.wait_for_frames = false;
       }
-      if (c.view) ro.seconds = 2.0;  // the view paces real time: keep it short
       RenderOutcome out = run_render(ro);
       step_s.insert(step_s.end(), out.step_s.begin(), out.step_s.end());
       publish_s.insert(publish_s.end(), out.publish_s.begin(), out.publish_s.end());
@@ -73,8 +74,9 @@ void run_bench(const BenchViewOptions& o) {
     }
     const double med = sim_quantile(step_s, 0.5) * 1e6, p99 = sim_quantile(step_s, 0.99) * 1e6;
     const double pub_med = sim_quantile(publish_s, 0.5) * 1e6, pub_p99 = sim_quantile(publish_s, 0.99) * 1e6;
-    std::printf("%-22s %12.1f %10.1f %14.2f %12.2f %9llu %9llu %9.1f\n", c.name.c_str(), med, p99, pub_med, pub_p99,
-                static_cast<unsigned long long>(written), static_cast<unsigned long long>(dropped), sim_quantile(frame_s, 0.5) * 1e3);
+    std::printf("%-22s %12.1f %10.1f %14.2f %12.2f %9llu %9llu %9.1f %11llu\n", c.name.c_str(), med, p99, pub_med, pub_p99,
+                static_cast<unsigned long long>(written), static_cast<unsigned long long>(dropped), sim_quantile(frame_s, 0.5) * 1e3,
+                static_cast<unsigned long long>(view_frames));
     rows.push_back({{"configuration", c.name},
                     {"host_step_us", {{"median", med}, {"p99", p99}, {"samples", step_s.size()}}},
                     {"capture_publish_us", {{"median", pub_med}, {"p99", pub_p99}, {"samples", publish_s.size()}}},

@@ -208,7 +208,7 @@ std::optional<host::SceneCollisionMethod> run_pass(const RenderOptions& o, const
   }
   // Trajectory done: with the window still open, keep showing the end until it is closed or a
   // method switch restarts the scene.
-  if (sinks.window != nullptr && !sinks.window->closed()) {
+  if (o.hold_view_at_end && sinks.window != nullptr && !sinks.window->closed()) {
     if (!o.quiet) std::printf("render %s: trajectory done; press M in the window to rerun with the next method, Q to quit\n", scene.name.c_str());
     while (!sinks.window->closed()) {
       if (sinks.window->method_switch_requests() != switches_at_start) return next_method(method);

@@ -29,6 +29,7 @@ struct RenderOptions {
   bool view = false;
   bool realtime = false;         ///< pace steps at wall-clock rate (implied by --view)
   bool publish_only = false;     ///< bench: capture + publish into an exchange nobody reads
+  bool hold_view_at_end = true;  ///< keep the window (and the process) up after the trajectory until closed
   bool quiet = false;
 };
 
