@@ -281,12 +281,14 @@ TEST(LinkBridgeLockstep, LoopbackSplitReproducesTheInProcessForce) {
   //    dynamics amplify the ~6e-8 relative rounding (the reference itself jitters by ±0.5 N
   //    while the hand holds still), so the stated tolerance is on what the hand feels:
   //    contact starts within 1 ms, the mean force over the hold is within 5 % of peak, and the
-  //    release (the soft surface letting go of the rising spatula, the most sensitive moment;
-  //    measured 12 ms apart) within 20 ms.
+  //    release (the soft surface letting go of the rising spatula, the most sensitive moment)
+  //    within 50 ms. The release is a chaotic event, not a property of the link: 12 ms apart
+  //    with the first host_sim weighting, 28 ms after the contacted-share area weighting
+  //    (87d0dc4) changed the physics — the exactness of the link is check 1, not this one.
   const HoldFigures a = hold_figures(reference);
   const HoldFigures b = hold_figures(split);
   EXPECT_LE(std::abs(a.contact_start_ns - b.contact_start_ns), kTickNs);
-  EXPECT_LE(std::abs(a.contact_end_ns - b.contact_end_ns), 20 * kTickNs) << a.contact_end_ns << " vs " << b.contact_end_ns;
+  EXPECT_LE(std::abs(a.contact_end_ns - b.contact_end_ns), 50 * kTickNs) << a.contact_end_ns << " vs " << b.contact_end_ns;
   EXPECT_NEAR(a.hold_mean_n, b.hold_mean_n, 0.05 * peak_n);
   std::size_t identical_ticks = 0;
   while (identical_ticks < split.time_ns.size() && split.contact_force_n[identical_ticks] == reference.contact_force_n[identical_ticks]) {
