@@ -10,6 +10,7 @@
 // read costs ~20–40 ns on this VM, more than a third of an IK), time per solve = batch
 // time / 64; median and p99 are over batches pooled from all repeats.
 #include "bench_kinematics.hpp"
+#include "machine_info.hpp"
 
 #include <sys/utsname.h>
 
@@ -248,32 +249,6 @@ double jacobian_max_relative_error(const std::vector<Eigen::Vector3d>& points) {
     }
   }
   return worst;
-}
-
-nlohmann::json machine_info() {
-  nlohmann::json machine;
-  machine["nproc"] = std::thread::hardware_concurrency();
-  std::string cpu_model = "unknown";
-  std::ifstream cpuinfo("/proc/cpuinfo");
-  for (std::string line; std::getline(cpuinfo, line);) {
-    if (line.rfind("model name", 0) == 0 || line.rfind("Model", 0) == 0) {
-      cpu_model = line.substr(line.find(':') + 2);
-      break;
-    }
-  }
-  machine["cpu_model"] = cpu_model;
-  utsname names{};
-  if (uname(&names) == 0) {
-    machine["kernel"] = std::string(names.sysname) + " " + names.release + " " + names.version;
-    machine["arch"] = names.machine;
-  }
-  machine["compiler"] = __VERSION__;
-#ifdef NDEBUG
-  machine["assertions"] = false;
-#else
-  machine["assertions"] = true;
-#endif
-  return machine;
 }
 
 nlohmann::json to_json(const SolveStats& s) {

@@ -17,6 +17,7 @@
 // fade, before passivity/safety) as % of the oracle's peak |F|, max |ΔF| per tick, and host CPU
 // time (thread CPU clock) per simulated second, plus host step time median/p99.
 #include "bench_proxy.hpp"
+#include "machine_info.hpp"
 
 #include <sys/utsname.h>
 #include <time.h>
@@ -135,23 +136,6 @@ struct BenchOptions {
   double duration_s = 0.0;
   double settle_s = 1.0;
 };
-
-nlohmann::json machine_json() {
-  nlohmann::json machine;
-  machine["nproc"] = std::thread::hardware_concurrency();
-  std::string cpu_model = "unknown";
-  std::ifstream cpuinfo("/proc/cpuinfo");
-  for (std::string line; std::getline(cpuinfo, line);) {
-    if (line.rfind("model name", 0) == 0) {
-      cpu_model = line.substr(line.find(':') + 2);
-      break;
-    }
-  }
-  machine["cpu_model"] = cpu_model;
-  utsname names{};
-  if (uname(&names) == 0) machine["kernel"] = std::string(names.sysname) + " " + names.release + " " + names.version;
-  return machine;
-}
 
 struct ErrorFigures {
   double rms_pct = 0.0;
@@ -278,7 +262,7 @@ void run_bench(const BenchOptions& options) {
                    {"replay_peak_error_pct", self_error.peak_pct}};
   out["targets"] = {{"rms_error_pct_at_100_hz", 2.0}, {"rms_error_pct_at_1000_hz", 0.5}, {"max_dforce_n", 0.05}};
   out["rows"] = rows;
-  out["machine"] = machine_json();
+  out["machine"] = machine_info();
   if (!options.json_path.empty()) {
     std::ofstream file(options.json_path);
     if (!file) throw CommandError("cannot write '" + options.json_path + "'");

@@ -23,6 +23,7 @@
 //    only while the wall pushes (virtual wall plus the device's physical damper, the port
 //    Colgate & Schenkel's bound is about), from SimFalcon's ground truth.
 #include "bench_rt.hpp"
+#include "machine_info.hpp"
 
 #include <sys/utsname.h>
 #include <unistd.h>
@@ -76,27 +77,6 @@ constexpr double kZwidthFirstK_n_per_m = 250.0;
 constexpr double kZwidthGridRatio = 1.25;
 constexpr double kZwidthMaxK_n_per_m = 400'000.0;
 constexpr double kStablePeakToPeak_m = 0.25e-3;
-
-nlohmann::json machine_info() {
-  nlohmann::json machine;
-  machine["nproc"] = std::thread::hardware_concurrency();
-  std::string cpu_model = "unknown";
-  std::ifstream cpuinfo("/proc/cpuinfo");
-  for (std::string line; std::getline(cpuinfo, line);) {
-    if (line.rfind("model name", 0) == 0 || line.rfind("Model", 0) == 0) {
-      cpu_model = line.substr(line.find(':') + 2);
-      break;
-    }
-  }
-  machine["cpu_model"] = cpu_model;
-  utsname names{};
-  if (uname(&names) == 0) {
-    machine["kernel"] = std::string(names.sysname) + " " + names.release + " " + names.version;
-    machine["arch"] = names.machine;
-  }
-  machine["compiler"] = __VERSION__;
-  return machine;
-}
 
 double quantile_sorted(const std::vector<double>& sorted, double q) {
   if (sorted.empty()) return 0.0;

@@ -1,5 +1,7 @@
 #include "session_runner.hpp"
 
+#include "machine_info.hpp"
+
 #include <sys/utsname.h>
 #include <unistd.h>
 
@@ -67,23 +69,6 @@ UsbFalcon open_usb_falcon(Clock& clock) {
     throw CommandError(std::string("--device usb: homing failed: ") + usb.driver->error());
   }
   return usb;
-}
-
-nlohmann::json machine_info() {
-  nlohmann::json machine;
-  machine["nproc"] = std::thread::hardware_concurrency();
-  std::string cpu_model = "unknown";
-  std::ifstream cpuinfo("/proc/cpuinfo");
-  for (std::string line; std::getline(cpuinfo, line);) {
-    if (line.rfind("model name", 0) == 0) {
-      cpu_model = line.substr(line.find(':') + 2);
-      break;
-    }
-  }
-  machine["cpu_model"] = cpu_model;
-  utsname names{};
-  if (uname(&names) == 0) machine["kernel"] = std::string(names.sysname) + " " + names.release + " " + names.version;
-  return machine;
 }
 
 nlohmann::json quantile_json(std::vector<double> values) {

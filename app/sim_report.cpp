@@ -1,6 +1,8 @@
 // Machine info, quantiles and progress output for the host-sim commands (sim_report.hpp).
 #include "sim_report.hpp"
 
+#include "machine_info.hpp"
+
 #include <sys/utsname.h>
 #include <unistd.h>
 
@@ -12,22 +14,7 @@
 
 namespace fissure::app {
 
-nlohmann::json sim_machine_info() {
-  nlohmann::json machine;
-  machine["nproc"] = std::thread::hardware_concurrency();
-  std::ifstream cpuinfo("/proc/cpuinfo");
-  std::string line, model = "unknown";
-  while (std::getline(cpuinfo, line)) {
-    if (line.rfind("model name", 0) == 0) {
-      model = line.substr(line.find(':') + 2);
-      break;
-    }
-  }
-  machine["cpu_model"] = model;
-  utsname u{};
-  machine["kernel"] = uname(&u) == 0 ? std::string(u.sysname) + " " + u.release : "unknown";
-  return machine;
-}
+nlohmann::json sim_machine_info() { return machine_info(); }
 
 double sim_quantile(std::vector<double> samples, double q) {
   if (samples.empty()) return 0.0;
