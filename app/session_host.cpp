@@ -1,5 +1,7 @@
 #include "session_host.hpp"
 
+#include "fissure/shared/message_validation.hpp"
+
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -56,7 +58,17 @@ void SessionHost::settle(double seconds) { sim_.settle(seconds); }
 
 const HostStatus& SessionHost::step(rt::DeviceStateExchange& state_in, rt::ProxyExchange& proxy_out) {
   const auto start = std::chrono::steady_clock::now();
-  if (state_in.try_fetch(device_)) have_device_ = true;
+  DeviceState incoming;
+  if (state_in.try_fetch(incoming)) {
+    // A non-finite sample (a corrupt link, a broken device) would turn Bullet's soft body to
+    // NaN for good: keep the tool at the last finite sample and count the rejection.
+    if (is_finite(incoming)) {
+      device_ = incoming;
+      have_device_ = true;
+    } else {
+      ++status_.rejected_device_states;
+    }
+  }
   const DeviceMapping& mapping = scene_.device_mapping;
   rt::ToolState tool;
   if (have_device_) {

@@ -28,6 +28,7 @@ struct HostStatus {
   double step_cpu_s = 0.0;            ///< wall time of the step (simulation + proxy)
   double jaw_gap_m = 0.0;             ///< clamp: gap the host applied
   std::uint64_t proxy_sequence = 0;
+  std::uint64_t rejected_device_states = 0;  ///< non-finite samples dropped before the scene
 };
 
 /// The proxy builder's model for a scene's host simulation (planes per jaw, jaw → rt part).

@@ -694,7 +694,6 @@ std::vector<StressCase> stress_cases() {
       "rt_core passivity: observer energy grows past the bound (controller cannot hold E <= 0 here)";
   const std::string crossing = "host_sim paired collision: a soft node ends on the wrong side of the tool";
   const std::pair<const char*, std::string> known[] = {
-      {"device_state_nan_to_host", "app/session_host: a non-finite DeviceState reaches Bullet (NaN soft body, crossed nodes)"},
       {"hc_k_1e+08", passivity},
       {"hc_lambda_over_k_10", passivity},
       {"hc_lambda_over_k_100", passivity},

@@ -1,10 +1,11 @@
 # `fissure stress --profile ci` (issue 7): the numerical stability stress harness, every case
 # shortened so the whole profile runs in CI in minutes (the full profile runs ≥ 1e6 rt ticks per
-# case and is run by hand: fissure stress --profile full). Labelled "unit" so the default preset
-# runs it; the timeout is issue 7's 5-minute CI budget.
+# case and is run by hand: fissure stress --profile full). Labelled "stress": the default preset
+# runs it; the ASan preset leaves it out (it is a system test, and 5-10x slower there would
+# break issue 7's 5-minute budget). The timeout is that budget.
 if(TARGET fissure)
   add_test(NAME app.stress_ci
     COMMAND $<TARGET_FILE:fissure> stress --profile ci --json ${CMAKE_BINARY_DIR}/tests/stress-ci.json
     WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
-  set_tests_properties(app.stress_ci PROPERTIES LABELS "unit" TIMEOUT 300)
+  set_tests_properties(app.stress_ci PROPERTIES LABELS "stress" TIMEOUT 300)
 endif()
