@@ -29,16 +29,10 @@
 #include "session_runner.hpp"
 #include "split_device.hpp"
 
+#include "sigint_flag.hpp"
+
 namespace fissure::app {
 namespace {
-
-std::atomic<bool> g_interrupt{false};
-static_assert(std::atomic<bool>::is_always_lock_free, "set from a signal handler");
-
-extern "C" void on_sigint_host_command(int /*signal*/) {
-  g_interrupt.store(true, std::memory_order_relaxed);
-  std::signal(SIGINT, SIG_DFL);
-}
 
 /// While paused or waiting for the link the host still pumps the bridge this often [ns]:
 /// Hellos get answered and a returning rt_core is seen within a millisecond.
@@ -101,7 +95,7 @@ void run(const HostOptions& options) {
   TimeNs next = clock.now();
   for (;;) {
     const TimeNs now = clock.now();
-    if (g_interrupt.load(std::memory_order_relaxed) || (end_ns != 0 && now >= end_ns)) break;
+    if (SigintFlag::raised() || (end_ns != 0 && now >= end_ns)) break;
     bridge.pump_host(state_in, proxy_out);
     if (bridge.failed()) throw CommandError(bridge.status().error);
     if (established_at_ns < 0 && bridge.established()) {
@@ -168,7 +162,7 @@ void run(const HostOptions& options) {
               static_cast<unsigned long long>(late_steps), static_cast<unsigned long long>(pauses), to_seconds(paused_total_ns),
               crossed_nodes_max, host_force_max_n, static_cast<unsigned long long>(link.frames_discarded),
               static_cast<unsigned long long>(link.messages_discarded), static_cast<unsigned long long>(link.peer_restarts),
-              g_interrupt.load() ? " | stopped by Ctrl-C" : "");
+              SigintFlag::raised() ? " | stopped by Ctrl-C" : "");
   if (established_at_ns < 0) {
     throw CommandError("rt_core at " + options.transport + " never answered: link not established");
   }
@@ -192,19 +186,8 @@ void register_host_command(CommandTree& tree) {
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--quiet", options->quiet, "no status line");
   cmd->callback([options] {
-    g_interrupt.store(false);
-    struct sigaction action {};
-    action.sa_handler = on_sigint_host_command;
-    sigemptyset(&action.sa_mask);
-    struct sigaction previous {};
-    sigaction(SIGINT, &action, &previous);
-    try {
-      run(*options);
-    } catch (...) {
-      sigaction(SIGINT, &previous, nullptr);
-      throw;
-    }
-    sigaction(SIGINT, &previous, nullptr);
+    const SigintFlag sigint;
+    run(*options);
   });
 }
 

@@ -32,16 +32,10 @@
 #include "link_bridge.hpp"
 #include "split_device.hpp"
 
+#include "sigint_flag.hpp"
+
 namespace fissure::app {
 namespace {
-
-std::atomic<bool> g_interrupt{false};
-static_assert(std::atomic<bool>::is_always_lock_free, "set from a signal handler");
-
-extern "C" void on_sigint_rt_command(int /*signal*/) {
-  g_interrupt.store(true, std::memory_order_relaxed);
-  std::signal(SIGINT, SIG_DFL);
-}
 
 /// Bridge pump period [ns]: a quarter of the 1 kHz tick, so a proxy waits ≤ 0.25 ms in the
 /// bridge before rt_core can take it and a DeviceState leaves within 0.25 ms of its tick; at
@@ -150,7 +144,7 @@ void run(const RtOptions& options) {
                options.transport, options.rate_hz);
   while (!rt_done.load(std::memory_order_acquire)) {
     std::this_thread::sleep_for(std::chrono::milliseconds(kDrainPeriod_ms));
-    if (g_interrupt.load(std::memory_order_relaxed)) stop_rt.store(true);
+    if (SigintFlag::raised()) stop_rt.store(true);
     while (exchanges->telemetry.try_pop(sample)) {
       ++ticks;
       const Eigen::Vector3d force = as_eigen(sample.force_device_n);
@@ -205,7 +199,7 @@ void run(const RtOptions& options) {
               static_cast<unsigned long long>(loop.stats().overruns), ever_established ? "established" : "never established",
               static_cast<unsigned long long>(proxies_used), force_max_n,
               static_cast<unsigned long long>(link.frames_discarded), static_cast<unsigned long long>(link.messages_discarded),
-              static_cast<unsigned long long>(link.peer_restarts), g_interrupt.load() ? " | stopped by Ctrl-C" : "");
+              static_cast<unsigned long long>(link.peer_restarts), SigintFlag::raised() ? " | stopped by Ctrl-C" : "");
   if (!refused.empty()) throw CommandError(refused);
 }
 
@@ -227,19 +221,8 @@ void register_rt_command(CommandTree& tree) {
       ->check(CLI::IsMember({"best-effort", "enforce"}));
   cmd->add_flag("--quiet", options->quiet, "no status line");
   cmd->callback([options] {
-    g_interrupt.store(false);
-    struct sigaction action {};
-    action.sa_handler = on_sigint_rt_command;
-    sigemptyset(&action.sa_mask);
-    struct sigaction previous {};
-    sigaction(SIGINT, &action, &previous);
-    try {
-      run(*options);
-    } catch (...) {
-      sigaction(SIGINT, &previous, nullptr);
-      throw;
-    }
-    sigaction(SIGINT, &previous, nullptr);
+    const SigintFlag sigint;
+    run(*options);
   });
 }
 

@@ -15,16 +15,10 @@
 #include "fissure/host_sim/scene_loader.hpp"
 #include "session_runner.hpp"
 
+#include "sigint_flag.hpp"
+
 namespace fissure::app {
 namespace {
-
-std::atomic<bool> g_interrupt{false};
-static_assert(std::atomic<bool>::is_always_lock_free, "set from a signal handler");
-
-void on_run_sigint(int /*signal*/) {
-  g_interrupt.store(true, std::memory_order_relaxed);
-  std::signal(SIGINT, SIG_DFL);  // the second Ctrl-C ends the process at once
-}
 
 struct RunOptions {
   std::string scene;
@@ -59,21 +53,12 @@ void run(const RunOptions& options) {
   session.plot = !options.no_plot;
   session.passivity_controller = !options.no_passivity_controller;
   session.status_line = !options.quiet;
-  g_interrupt.store(false);
-  session.interrupt = &g_interrupt;
-  struct sigaction action {};
-  action.sa_handler = on_run_sigint;
-  sigemptyset(&action.sa_mask);
-  struct sigaction previous {};
-  sigaction(SIGINT, &action, &previous);
   SessionOutcome outcome;
-  try {
+  {
+    const SigintFlag sigint;
+    session.interrupt = &SigintFlag::flag();
     outcome = run_session(session);
-  } catch (...) {
-    sigaction(SIGINT, &previous, nullptr);
-    throw;
   }
-  sigaction(SIGINT, &previous, nullptr);
   const nlohmann::json& s = outcome.summary;
   std::printf("%s %s session of '%s': %.2f s, %llu ticks (%.0f Hz), host %llu steps\n",
               s["mode"].get<std::string>().c_str(), s["device"].get<std::string>().c_str(), scene.name.c_str(),
@@ -86,7 +71,7 @@ void run(const RunOptions& options) {
   std::printf("  proxy age median %.2f ms, p99 %.2f ms | host step median %.3f ms, p99 %.3f ms%s\n",
               s["proxy_age_ms"]["median"].get<double>(), s["proxy_age_ms"]["p99"].get<double>(),
               s["host_step_ms"]["median"].get<double>(), s["host_step_ms"]["p99"].get<double>(),
-              g_interrupt.load() ? " | stopped by Ctrl-C" : "");
+              SigintFlag::raised() ? " | stopped by Ctrl-C" : "");
   std::printf("  wrote %s, %s%s%s\n", outcome.trace_path.c_str(), outcome.summary_path.c_str(),
               outcome.plot_path.empty() ? "" : ", ", outcome.plot_path.c_str());
 }
