@@ -20,28 +20,16 @@ std::unique_ptr<SplitDevice> SplitDevice::open_sim(const std::optional<HandScrip
   return out;
 }
 
-// The same sequence as `fissure run --device usb` (session_runner.cpp): open, firmware, home.
 std::unique_ptr<SplitDevice> SplitDevice::open_usb(Clock& clock) {
   std::unique_ptr<SplitDevice> out(new SplitDevice());
-  std::string error;
-  out->usb_transport_ = falcon::LibusbFalconTransport::open(0, error);
-  if (!out->usb_transport_) throw CommandError("--device usb: " + error);
-  out->usb_driver_ = std::make_unique<falcon::FalconUsbDriver>(*out->usb_transport_, clock);
-  if (!out->usb_driver_->open()) throw CommandError(std::string("--device usb: ") + out->usb_driver_->error());
-  if (!out->usb_driver_->check_firmware()) {
-    throw CommandError("--device usb: Novint Falcon firmware not loaded: run 'fissure device firmware --file F' first");
-  }
-  std::fprintf(stderr, "homing: pull the grip all the way out, then push it all the way in …\n");
-  if (!out->usb_driver_->home([](std::uint8_t mask) { std::fprintf(stderr, "  arms homed: 0x%x\n", mask); })) {
-    throw CommandError(std::string("--device usb: homing failed: ") + out->usb_driver_->error());
-  }
+  out->usb_ = open_usb_falcon(clock);
   return out;
 }
 
 SplitDevice::~SplitDevice() = default;
 
 falcon::HapticDevice& SplitDevice::device() noexcept {
-  if (usb_driver_) return *usb_driver_;
+  if (usb_.driver) return *usb_.driver;
   return *sim_;
 }
 

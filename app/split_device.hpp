@@ -13,11 +13,7 @@
 #include "fissure/falcon_hw/sim_falcon.hpp"
 #include "fissure/shared/clock.hpp"
 #include "fissure/shared/transport_spec.hpp"
-
-namespace fissure::falcon {
-class LibusbFalconTransport;
-class FalconUsbDriver;
-}  // namespace fissure::falcon
+#include "usb_falcon.hpp"
 
 namespace fissure::app {
 
@@ -36,8 +32,7 @@ class SplitDevice {
  private:
   SplitDevice() = default;
   std::unique_ptr<falcon::SimFalcon> sim_;
-  std::unique_ptr<falcon::LibusbFalconTransport> usb_transport_;
-  std::unique_ptr<falcon::FalconUsbDriver> usb_driver_;
+  UsbFalcon usb_;  ///< empty for sim
 };
 
 /// Wraps a device and records how long each try_exchange took [ns] into a buffer sized up
