@@ -1,0 +1,660 @@
+#!/usr/bin/python3
+"""Turn the JSON of `fissure bench all` into PNG plots and a Markdown report (issue 7).
+
+usage: make_report.py DIR [--md FILE] [--images DIR]
+
+DIR holds what `fissure bench all --out DIR` wrote: kinematics.json, rt.json, collision.json,
+proxy.json, pareto.json, view.json, stress.json and bench_all.json (which children ran, their
+exit codes and wall times). --md (default DIR/report.md) is the report; --images (default DIR)
+receives the PNGs, linked from the report by relative paths, so a report written to
+docs/benchmarks.md with --images docs/images/bench works from docs/.
+
+Every figure stands beside its target with "met" or "MISSED" (targets.py says where each target
+comes from). A benchmark whose JSON is missing or unreadable is reported as such, never skipped
+silently. Uses only the standard library and matplotlib (Debian's python3-matplotlib).
+"""
+import argparse
+import json
+import math
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")  # headless: CI and SSH sessions have no display
+import matplotlib.pyplot as plt  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from targets import MET, MISSED, NOT_CHECKED, Target, evaluate_all  # noqa: E402
+
+REGENERATE = "build/bin/fissure bench all --out out/bench --docs docs"
+
+BENCHMARKS = ["kinematics", "rt", "collision", "proxy", "pareto", "view", "stress"]
+
+
+def load_inputs(directory):
+    data, problems = {}, {}
+    for name in BENCHMARKS + ["bench_all"]:
+        path = os.path.join(directory, name + ".json")
+        if not os.path.exists(path):
+            problems[name] = "no " + name + ".json"
+            continue
+        try:
+            with open(path) as f:
+                data[name] = json.load(f)
+        except (OSError, ValueError) as e:
+            problems[name] = f"{name}.json unreadable: {e}"
+    return data, problems
+
+
+# ---------------------------------------------------------------- formatting helpers
+
+
+def fmt(value, digits=3):
+    if value is None:
+        return "—"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if math.isnan(value) or math.isinf(value):
+            return str(value)
+        if value != 0 and (abs(value) >= 1e5 or abs(value) < 1e-3):
+            return f"{value:.{digits - 1}e}"
+        return f"{value:.{digits}g}" if abs(value) < 1000 else f"{value:.0f}"
+    return str(value)
+
+
+def cell_text(value):
+    # A "|" inside a cell (|F|, |ΔF|) would split the Markdown table.
+    return str(value).replace("|", "\\|").replace("\n", " ")
+
+
+def table(header, rows):
+    out = ["| " + " | ".join(cell_text(h) for h in header) + " |", "|" + "|".join("---" for _ in header) + "|"]
+    for row in rows:
+        out.append("| " + " | ".join(cell_text(c) for c in row) + " |")
+    return "\n".join(out) + "\n"
+
+
+def status_text(status):
+    return {MET: "met", MISSED: "**MISSED**", NOT_CHECKED: "not checked"}[status]
+
+
+def targets_table(targets):
+    if not targets:
+        return ""
+    rows = [[t.description, t.measured, status_text(t.status), t.source] for t in targets]
+    return table(["target", "measured", "status", "from"], rows)
+
+
+class Report:
+    def __init__(self, md_path, image_dir):
+        self.md_path = md_path
+        self.image_dir = image_dir
+        self.lines = []
+        self.images = []
+
+    def add(self, text=""):
+        self.lines.append(text)
+
+    def figure(self, fig, name, caption):
+        path = os.path.join(self.image_dir, name)
+        fig.tight_layout()
+        fig.savefig(path, dpi=110)
+        plt.close(fig)
+        self.images.append(path)
+        rel = os.path.relpath(path, os.path.dirname(os.path.abspath(self.md_path)))
+        self.add(f"![{caption}]({rel.replace(os.sep, '/')})")
+        self.add("")
+
+    def text(self):
+        return "\n".join(self.lines) + "\n"
+
+
+# ---------------------------------------------------------------- Pareto helper
+
+
+def pareto_front(points):
+    """Indices of the non-dominated points (minimise both time and error)."""
+    front = []
+    for i, (t, e) in enumerate(points):
+        dominated = any((t2 <= t and e2 <= e) and (t2 < t or e2 < e) for j, (t2, e2) in enumerate(points) if j != i)
+        if not dominated:
+            front.append(i)
+    return sorted(front, key=lambda i: points[i][0])
+
+
+def pareto_plot(ax, series, xlabel, ylabel, logx=False, logy=False):
+    """series: list of (label, [(time, error, point_label, is_reference)], marker)."""
+    for label, points, marker in series:
+        xs = [p[0] for p in points]
+        ys = [p[1] for p in points]
+        line = ax.plot(xs, ys, marker=marker, ls=":", lw=0.8, label=label)[0]
+        colour = line.get_color()
+        front = pareto_front([(p[0], p[1]) for p in points])
+        if len(front) > 1:
+            ax.plot([xs[i] for i in front], [ys[i] for i in front], ls="-", lw=2.0, alpha=0.35, color=colour)
+        for x, y, text, reference in points:
+            ax.annotate(text + (" (ref)" if reference else ""), (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7,
+                        color=colour)
+    if logx:
+        ax.set_xscale("log")
+    if logy:
+        ax.set_yscale("log")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize="small")
+
+
+# ---------------------------------------------------------------- sections
+
+
+def section_header(report, data, problems, targets):
+    bench_all = data.get("bench_all", {})
+    machine = None
+    for name in ["bench_all"] + BENCHMARKS:
+        if name in data and isinstance(data[name].get("machine"), dict):
+            machine = data[name]["machine"]
+            break
+    report.add("# Fissure benchmarks: run time against error")
+    report.add("")
+    report.add("Generated by `fissure bench all` (issue 7). **Regenerate with one command** from the repository root after "
+               "building:")
+    report.add("")
+    report.add("```")
+    report.add(REGENERATE)
+    report.add("```")
+    report.add("")
+    report.add("(`--quick` gives short runs for development; the committed report is a full run. `--report-only` remakes the "
+               "plots and this file from the JSON already in `--out`.)")
+    report.add("")
+    if bench_all:
+        report.add(f"This run: `{bench_all.get('invocation', '?')}`, started {bench_all.get('started_utc', '?')}, "
+                   f"{fmt(bench_all.get('wall_s'))} s wall in all"
+                   + (" — **a --quick run: short, not the figures to quote**" if bench_all.get("quick") else "") + ".")
+        if bench_all.get("loadavg_at_end"):
+            report.add(f"Load average at the end (`/proc/loadavg`): `{bench_all['loadavg_at_end']}` — timings on a shared "
+                       "VM; ratios measured within one run are the robust figures.")
+        report.add("")
+    report.add("## Machine")
+    report.add("")
+    if machine:
+        report.add(table(["nproc", "CPU", "kernel", "arch", "compiler", "assertions"],
+                         [[fmt(machine.get("nproc")), machine.get("cpu_model", "?"), machine.get("kernel", "?"),
+                           machine.get("arch", "?"), machine.get("compiler", "?"), fmt(machine.get("assertions"))]]))
+    else:
+        report.add("No JSON carried a `machine` object.\n")
+    report.add("## Targets at a glance")
+    report.add("")
+    met = sum(1 for t in targets if t.status == MET)
+    missed = sum(1 for t in targets if t.status == MISSED)
+    unchecked = sum(1 for t in targets if t.status == NOT_CHECKED)
+    report.add(f"**{met} met, {missed} missed, {unchecked} not checked** of {len(targets)} targets. Each section below shows "
+               "its figures beside these targets.")
+    report.add("")
+    rows = [[t.section, t.description, t.measured, status_text(t.status)] for t in targets]
+    report.add(table(["section", "target", "measured", "status"], rows))
+    report.add("## The benchmark runs")
+    report.add("")
+    children = bench_all.get("children", {}) if isinstance(bench_all.get("children"), dict) else {}
+    rows = []
+    for name in BENCHMARKS:
+        child = children.get(name)
+        if child is None:
+            rows.append([name, "—", "not run by bench all", "—", "yes" if name in data else "no"])
+            continue
+        if child.get("ok"):
+            outcome = "ok"
+        elif child.get("signal"):
+            outcome = f"**FAILED**: signal {child['signal']}"
+        elif child.get("error"):
+            outcome = f"**FAILED**: {child['error']}"
+        else:
+            outcome = f"**FAILED**: exit {child.get('exit_code')}"
+        rows.append([name, f"`{child.get('command', '?')}`", outcome, fmt(child.get("wall_s")),
+                     "yes" if name in data else "**no**"])
+    report.add(table(["benchmark", "command", "outcome", "wall s", "JSON"], rows))
+    for name, problem in problems.items():
+        if name != "bench_all":
+            report.add(f"* `{name}`: {problem} — its section says so.")
+    report.add("")
+
+
+def missing(report, name, problems):
+    report.add(f"*No data: {problems.get(name, name + '.json missing')}.*")
+    report.add("")
+
+
+def section_pareto(report, data, problems, targets):
+    report.add("## Run time against error (Pareto plots)")
+    report.add("")
+    report.add("Each plot puts the cost of a knob setting against the error it leaves; the thick translucent line joins the "
+               "Pareto-optimal settings (nothing else is both faster and more accurate).")
+    report.add("")
+    # (a) host rate
+    report.add("### (a) Host rate — `fissure bench proxy`")
+    report.add("")
+    proxy = data.get("proxy")
+    if proxy:
+        rows = proxy["rows"]
+        oracle = proxy.get("oracle", {})
+        pts = [(r["host_cpu_s_per_s"], r["rms_error_pct"], f"{r['host_hz']:.0f} Hz", False) for r in rows]
+        if oracle:
+            pts.append((oracle.get("host_cpu_s_per_s", 0.0), 0.0, f"{oracle.get('host_hz', 0):.0f} Hz", True))
+        fig, ax = plt.subplots(figsize=(6.5, 4.2))
+        pareto_plot(ax, [("RMS force error", pts, "o"),
+                         ("peak force error", [(r["host_cpu_s_per_s"], r["peak_error_pct"], f"{r['host_hz']:.0f} Hz", False)
+                                               for r in rows], "s")],
+                    "host CPU time per simulated second [s/s]", "force error [% of the oracle's peak |F|]")
+        ax.set_title(f"host rate: rendered force vs every-tick oracle ({proxy.get('scene', '?')}, rt {fmt(proxy.get('rt_rate_hz'))} Hz)",
+                     fontsize=9)
+        report.figure(fig, "pareto_host_rate.png", "host rate: host CPU against force error")
+        report.add(f"Oracle: the host refreshes the proxy every rt tick ({fmt(oracle.get('host_hz'))} Hz), peak |F| "
+                   f"{fmt(oracle.get('peak_force_n'))} N; force compared: {proxy.get('force_compared', '?')}.")
+        report.add("")
+        report.add(table(["host Hz", "RMS error %", "peak error %", "max |ΔF|/tick N", "host CPU s/s", "host step median ms",
+                          "crossed nodes"],
+                         [[fmt(r["host_hz"]), fmt(r["rms_error_pct"]), fmt(r["peak_error_pct"]), fmt(r["max_dforce_n"]),
+                           fmt(r["host_cpu_s_per_s"]), fmt(r.get("host_step_ms", {}).get("median")),
+                           fmt(r.get("crossed_nodes_max"))] for r in rows]))
+        report.add(targets_table([t for t in targets if t.section == "proxy"]))
+    else:
+        missing(report, "proxy", problems)
+    pareto = data.get("pareto")
+    for key, title, knob_label, unit_fn in [
+            ("node_spacing", "(b) Tool node resolution — `fissure bench pareto`", "node spacing",
+             lambda v: f"{v * 1e3:g} mm"),
+            ("substeps", "(c) Host sub-steps — `fissure bench pareto`", "sub-steps", lambda v: f"{v:g}")]:
+        report.add("### " + title)
+        report.add("")
+        if not pareto:
+            missing(report, "pareto", problems)
+            continue
+        rows = pareto[key]
+        knob = "node_spacing_m" if key == "node_spacing" else "substeps"
+        pts = [(r["host_step_in_contact_us"]["median"], r["rms_error_pct"], unit_fn(r[knob]), r.get("reference", False))
+               for r in rows]
+        fig, ax = plt.subplots(figsize=(6.5, 4.2))
+        pareto_plot(ax, [("RMS force error", pts, "o"),
+                         ("peak force error", [(r["host_step_in_contact_us"]["median"], r["peak_error_pct"], unit_fn(r[knob]),
+                                                r.get("reference", False)) for r in rows], "s")],
+                    "host step time in contact, median [µs]", "host force error [% of the reference's peak |F|]",
+                    logx=key == "node_spacing")
+        ax.set_title(f"{knob_label}: host step time vs force error ({pareto.get('scene', '?')}, scripted press-and-hold)",
+                     fontsize=9)
+        report.figure(fig, f"pareto_{key}.png", f"{knob_label}: host step time against force error")
+        if key == "node_spacing":
+            report.add(f"The scene's tool node spacing swept coarse → fine at {fmt(pareto.get('scene_substeps_count'))} sub-step(s); "
+                       "the finest is the reference. ")
+        else:
+            report.add(f"Sub-steps per {fmt(pareto.get('host_step_s', 0) * 1e3)} ms host step at the scene's node spacing "
+                       f"({fmt(pareto.get('scene_node_spacing_m', 0) * 1e3)} mm); the most sub-steps is the reference.")
+        report.add(f"Same scripted trajectory ({fmt(pareto.get('trajectory_s'))} s after {fmt(pareto.get('settle_s'))} s settling) "
+                   f"for every row, {pareto.get('repeats', '?')} repeat(s) per row.")
+        report.add("")
+        report.add(table([knob_label, "tool nodes", "step median µs", "step p99 µs", "in-contact median µs", "RMS error %",
+                          "peak error %", "crossed nodes", "max penetration mm", "deterministic"],
+                         [[unit_fn(r[knob]) + (" (ref)" if r.get("reference") else ""), fmt(r.get("tool_nodes")),
+                           fmt(r["host_step_us"]["median"]), fmt(r["host_step_us"]["p99"]),
+                           fmt(r["host_step_in_contact_us"]["median"]), fmt(r["rms_error_pct"]), fmt(r["peak_error_pct"]),
+                           fmt(r["crossed_nodes_max"]), fmt(r["max_penetration_m"] * 1e3), fmt(r.get("deterministic"))]
+                          for r in rows]))
+        report.add(targets_table([t for t in targets if t.section == "pareto " + key]))
+    # (d) FK tolerance
+    report.add("### (d) Forward-kinematics tolerance — `fissure bench kinematics`")
+    report.add("")
+    kin = data.get("kinematics")
+    if kin:
+        table_rows = kin["tolerance_table"]
+        series = []
+        for start, marker in (("warm", "o"), ("cold", "s")):
+            pts = [(r["median_ns"], max(r["error_max_m"], 1e-16), f"{r['tolerance_rad']:.0e}", False)
+                   for r in table_rows if r["start"] == start]
+            if pts:
+                series.append((f"{start} start (max error)", pts, marker))
+        base = kin.get("baseline_libnifalcon")
+        if base:
+            series.append(("libnifalcon scheme", [(base["median_ns"], base["error_max_m"], "0.01 rad", False)], "x"))
+        fig, ax = plt.subplots(figsize=(6.5, 4.2))
+        pareto_plot(ax, series, "time per FK solve, median [ns]", "position error, max [m]", logx=True, logy=True)
+        ax.axhline(1e-6, color="grey", ls="--", lw=0.8)
+        ax.axvline(500, color="grey", ls="--", lw=0.8)
+        ax.set_title("FK tolerance [rad]: time vs error on a 1 kHz hand trajectory", fontsize=9)
+        report.figure(fig, "pareto_fk_tolerance.png", "FK tolerance: time against error")
+        report.add("Dashed lines: the target (≤ 1 µm in ≤ 500 ns). " + kin.get("method", {}).get("timing", ""))
+        report.add("")
+        report.add(table(["start", "tolerance rad", "iterations mean", "iterations max", "median ns", "p99 ns", "error median m",
+                          "error max m"],
+                         [[r["start"], f"{r['tolerance_rad']:.0e}", fmt(r["iterations_mean"]), fmt(r["iterations_max"]),
+                           fmt(r["median_ns"]), fmt(r["p99_ns"]), fmt(r["error_median_m"]), fmt(r["error_max_m"])]
+                          for r in table_rows]
+                         + ([["libnifalcon", "0.01", fmt(base["iterations_mean"]), fmt(base["iterations_max"]),
+                              fmt(base["median_ns"]), fmt(base["p99_ns"]), fmt(base["error_median_m"]), fmt(base["error_max_m"])]]
+                            if base else [])))
+        report.add(f"IK {fmt(kin.get('ik_median_ns'))} ns, Jacobian {fmt(kin.get('jacobian_median_ns'))} ns, warm FK + J "
+                   f"{fmt(kin.get('fk_warm_with_jacobian_median_ns'))} ns (medians); Jacobian vs central differences "
+                   f"{fmt(kin.get('jacobian_max_rel_error'))} relative.")
+        report.add("")
+        report.add(targets_table([t for t in targets if t.section == "kinematics"]))
+    else:
+        missing(report, "kinematics", problems)
+
+
+def section_tunnelling(report, data, problems, targets):
+    report.add("## Tunnelling against Bullet's own collision — `fissure bench collision`")
+    report.add("")
+    col = data.get("collision")
+    if not col:
+        missing(report, "collision", problems)
+        return
+    sweep = col["sweep"]
+    speeds = sorted({r["speed_m_s"] for r in sweep})
+    tools = list(dict.fromkeys(r["tool"] for r in sweep))
+    methods = list(dict.fromkeys(r["method"] for r in sweep))
+    cell = {(r["tool"], r["method"], r["speed_m_s"]): r for r in sweep}
+    fig, axes = plt.subplots(1, len(methods), figsize=(3.6 * len(methods), 3.4), sharey=True)
+    if len(methods) == 1:
+        axes = [axes]
+    vmax = max(1, max(r["crossed_nodes"] for r in sweep))
+    for ax, method in zip(axes, methods):
+        grid = [[cell.get((t, method, v), {}).get("crossed_nodes", float("nan")) for v in speeds] for t in tools]
+        image = ax.imshow(grid, cmap="Reds", vmin=0, vmax=vmax, aspect="auto")
+        for i, row in enumerate(grid):
+            for j, value in enumerate(row):
+                ax.text(j, i, "" if value != value else str(int(value)), ha="center", va="center", fontsize=8,
+                        color="white" if value == value and value > 0.6 * vmax else "black")
+        ax.set_xticks(range(len(speeds)))
+        ax.set_xticklabels([f"{v:g}" for v in speeds], fontsize=7)
+        ax.set_yticks(range(len(tools)))
+        ax.set_yticklabels(tools, fontsize=8)
+        ax.set_xlabel("tool speed [m/s]")
+        ax.set_title(method, fontsize=9)
+    fig.colorbar(image, ax=list(axes), shrink=0.8, label="crossed nodes")
+    fig.suptitle("crossed soft nodes after a plunge and hold (must be 0)", fontsize=9)
+    path_caption = "tunnelling sweep: crossed nodes per tool, method and speed"
+    # tight_layout does not know colorbars spanning axes; keep the default layout.
+    name = "tunnelling.png"
+    path = os.path.join(report.image_dir, name)
+    fig.savefig(path, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+    report.images.append(path)
+    rel = os.path.relpath(path, os.path.dirname(os.path.abspath(report.md_path)))
+    report.add(f"![{path_caption}]({rel.replace(os.sep, '/')})")
+    report.add("")
+    report.add("Cells: crossed nodes / max penetration into the tool [mm] / median step [µs]. `bullet` is Bullet's own SDF_RS "
+               "soft-rigid collision set up fairly (fine voxel, mm margin, kKHR 1); `ray` is the paper's rays without "
+               "pairing; `paired` is ours.")
+    report.add("")
+    rows = []
+    for t in tools:
+        for m in methods:
+            cells = []
+            for v in speeds:
+                r = cell.get((t, m, v))
+                cells.append("—" if r is None else
+                             f"{r['crossed_nodes']}/{r['max_penetration_m'] * 1e3:.2f}/{r['step_median_us']:.0f}")
+            rows.append([t, m] + cells)
+    report.add(table(["tool", "method"] + [f"{v:g} m/s" for v in speeds], rows))
+    jitter_rows = [r for r in sweep if r["method"] == "paired"]
+    report.add("Hold after the plunge (paired): force jitter (residual std / mean about a fitted line) and drift; "
+               "`lost` = no contact left in the hold.")
+    report.add("")
+    report.add(table(["tool"] + [f"{v:g} m/s" for v in speeds],
+                     [[t] + [("lost" if not (cell.get((t, "paired", v)) or {}).get("hold_in_contact")
+                              else f"{100 * cell[(t, 'paired', v)]['force_jitter']:.2f}% / "
+                                   f"{100 * (cell[(t, 'paired', v)].get('force_drift') or 0):+.1f}%")
+                             if (t, "paired", v) in cell else "—" for v in speeds]
+                      for t in tools if any(r["tool"] == t for r in jitter_rows)]))
+    report.add(targets_table([t for t in targets if t.section == "collision sweep"]))
+
+    report.add("### Force–indentation and mesh convergence")
+    report.add("")
+    ind = col.get("indentation")
+    conv = col.get("convergence")
+    if ind:
+        fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
+        for key, label in (("slab_curve", f"flat slab (fitted n {fmt(ind.get('slab_fitted_n'))})"),
+                           ("sphere_curve", f"sphere {ind.get('sphere_faces', '?')} faces (fitted n {fmt(ind.get('sphere_fitted_n'))})")):
+            curve = ind.get(key) or []
+            if curve:
+                axes[0].plot([p["depth_m"] * 1e3 for p in curve], [p["force_n"] for p in curve], "o-", label=label)
+        axes[0].set_xscale("log")
+        axes[0].set_yscale("log")
+        axes[0].set_xlabel("depth [mm]")
+        axes[0].set_ylabel("force [N]")
+        axes[0].set_title(f"force–indentation (configured n {fmt(ind.get('configured_n'))})", fontsize=9)
+        axes[0].grid(True, which="both", alpha=0.3)
+        axes[0].legend(fontsize="small")
+        if conv:
+            axes[1].plot([r["faces"] for r in conv], [r["force_at_depth_n"] for r in conv], "o-")
+            axes[1].set_xscale("log")
+            axes[1].set_xlabel("sphere faces")
+            axes[1].set_ylabel(f"force at {fmt(conv[0].get('depth_m', 0) * 1e3)} mm [N]")
+            axes[1].set_title("mesh convergence (area-weighted HC)", fontsize=9)
+            axes[1].grid(True, which="both", alpha=0.3)
+        report.figure(fig, "indentation.png", "force-indentation curves and mesh convergence")
+        report.add(table(["specimen", "fitted exponent", "expected"],
+                         [["flat slab (fixed contact set)", fmt(ind.get("slab_fitted_n"), 4), fmt(ind.get("configured_n"))],
+                          [f"sphere, {ind.get('sphere_faces', '?')} faces", fmt(ind.get("sphere_fitted_n"), 4),
+                           f"{fmt(ind.get('sphere_predicted_n'))} (rigid cap n+1; the soft shell also squashes as a whole)"]]))
+    if conv:
+        report.add(table(["faces", "force at depth N"], [[r["faces"], fmt(r["force_at_depth_n"], 4)] for r in conv]))
+    report.add(targets_table([t for t in targets if t.section == "collision indentation"]))
+
+
+def section_scaling(report, data, problems, targets):
+    report.add("## Cost against mesh size — `fissure bench collision`")
+    report.add("")
+    col = data.get("collision")
+    if not col:
+        missing(report, "collision", problems)
+        return
+    rows = col["scaling"]
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    for method, in_contact, field, label, marker in [
+            ("paired", True, "step_median_us", "paired: whole step, in contact", "o"),
+            ("paired", True, "collision_median_us", "paired: collision only, in contact", "s"),
+            ("paired", False, "collision_median_us", "paired: collision only, out of contact", "v"),
+            ("bullet", True, "step_median_us", "bullet: whole step, in contact", "x"),
+            ("bullet", True, "collision_median_us", "bullet: collision only, in contact", "+")]:
+        pts = sorted((r["faces"], r[field]) for r in rows if r["method"] == method and r["in_contact"] == in_contact)
+        if pts:
+            ax.plot([p[0] for p in pts], [max(p[1], 1e-3) for p in pts], marker=marker, label=label)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("soft sphere faces")
+    ax.set_ylabel("median time per host step [µs]")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize="small")
+    ax.set_title("host step cost against mesh size (plate 4 mm into the sphere)", fontsize=9)
+    report.figure(fig, "cost_vs_mesh.png", "cost against mesh size")
+    report.add("128 faces is the paper's sphere (Bullet's ellipsoid); larger meshes are icospheres.")
+    report.add("")
+    report.add(table(["method", "faces", "contact", "contacts", "step median µs", "step p99 µs", "collision median µs"],
+                     [[r["method"], r["faces"], "in" if r["in_contact"] else "out", fmt(r.get("contacts")),
+                       fmt(r["step_median_us"]), fmt(r.get("step_p99_us")), fmt(r["collision_median_us"])] for r in rows]))
+    report.add(targets_table([t for t in targets if t.section == "collision scaling"]))
+
+
+def section_rt(report, data, problems, targets):
+    report.add("## rt_core: tick time, wake-up latency against cyclictest — `fissure bench rt`")
+    report.add("")
+    rt = data.get("rt")
+    if not rt:
+        missing(report, "rt", problems)
+        return
+    tick = rt.get("tick_ns", {})
+    rows = []
+    for key in ("patches_1", "patches_8", "reference_workload"):
+        if key in tick:
+            d = tick[key]
+            rows.append([key.replace("_", " "), fmt(d["median"]), fmt(d["p99"]), fmt(d["p999"]), fmt(d["max"]),
+                         fmt(d.get("samples"))])
+    report.add("Tick compute time (ns; `reference workload` is fixed arithmetic timed the same way on the same thread: the "
+               "machine's own noise):")
+    report.add("")
+    report.add(table(["workload", "median", "p99", "p99.9", "max", "samples"], rows))
+    wake = rt.get("wakeup_us", {})
+    cyc = rt.get("cyclictest_us", {})
+    rates = [k for k in ("1000hz", "4000hz") if isinstance(wake.get(k), dict)]
+    if rates:
+        fig, axes = plt.subplots(1, len(rates), figsize=(5 * len(rates), 3.8), sharey=True)
+        if len(rates) == 1:
+            axes = [axes]
+        stats = ["median", "p99", "p999", "max"]
+        for ax, key in zip(axes, rates):
+            ours = [wake[key].get(s) or 0 for s in stats]
+            theirs = [cyc.get(key, {}).get(s) or 0 for s in stats] if cyc.get(key, {}).get("available") else None
+            xs = range(len(stats))
+            ax.bar([x - 0.2 for x in xs], [max(v, 0.1) for v in ours], width=0.4, label="rt_core loop")
+            if theirs:
+                ax.bar([x + 0.2 for x in xs], [max(v, 0.1) for v in theirs], width=0.4, label="cyclictest")
+            ax.set_xticks(list(xs))
+            ax.set_xticklabels(["median", "p99", "p99.9", "max"])
+            ax.set_yscale("log")
+            ax.set_title(f"{key.replace('hz', ' Hz')}: {fmt(wake[key].get('overruns'))} overruns in {fmt(wake[key].get('ticks'))} ticks",
+                         fontsize=9)
+            ax.grid(True, axis="y", which="both", alpha=0.3)
+            ax.legend(fontsize="small")
+        axes[0].set_ylabel("wake-up latency [µs]")
+        # Log-scale bars start at 0: give the axis an explicit floor so the smallest bar shows.
+        smallest = min([wake[k].get(s) or 1.0 for k in rates for s in stats]
+                       + [cyc.get(k, {}).get(s) or 1.0 for k in rates for s in stats if cyc.get(k, {}).get("available")])
+        axes[0].set_ylim(bottom=max(0.1, smallest / 2.0))
+        report.figure(fig, "rt_latency_vs_cyclictest.png", "rt wake-up latency against cyclictest")
+        report.add(f"SCHED_FIFO runs of {fmt(rt.get('seconds'))} s per rate against SimFalcon; {rt.get('sched_fifo_mode', '')}.")
+        report.add("")
+        rows = []
+        for key in rates:
+            w = wake[key]
+            c = cyc.get(key, {})
+            rows.append([key, "rt_core", fmt(w["median"]), fmt(w["p99"]), fmt(w["p999"]), fmt(w["max"]), fmt(w.get("overruns")),
+                         fmt(w.get("sched_fifo"))])
+            if c.get("available"):
+                rows.append([key, "cyclictest", fmt(c["median"]), fmt(c["p99"]), fmt(c["p999"]), fmt(c["max"]), "—", "yes"])
+            else:
+                rows.append([key, "cyclictest", "unavailable: " + str(c.get("reason", "?")), "", "", "", "", ""])
+        report.add(table(["rate", "loop", "median µs", "p99 µs", "p99.9 µs", "max µs", "overruns", "SCHED_FIFO"], rows))
+    else:
+        report.add(f"*The SCHED_FIFO part was not run: {wake.get('skipped', 'no wakeup_us in rt.json')}.*")
+        report.add("")
+    report.add(targets_table([t for t in targets if t.section == "rt"]))
+
+    report.add("## Z-width against tick rate — `fissure bench rt`")
+    report.add("")
+    z = rt.get("zwidth") or []
+    if z:
+        fig, ax = plt.subplots(figsize=(6.5, 4.2))
+        rates_hz = [r["rate_hz"] for r in z]
+        ax.plot(rates_hz, [r["colgate_bound_k_n_per_m"] for r in z], "k--", label="Colgate–Schenkel bound 2b/T")
+        ax.plot(rates_hz, [r["k_max_passivity_off_n_per_m"] for r in z], "o-", label="K max, passivity controller off")
+        ax.plot(rates_hz, [r["k_max_passivity_on_n_per_m"] for r in z], "s-", label="K max, passivity controller on")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("tick rate [Hz]")
+        ax.set_ylabel("largest stable and passive stiffness [N/m]")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize="small")
+        ax.set_title(f"Z-width against SimFalcon's damping b = {fmt(z[0].get('device_damping_n_s_per_m'))} N·s/m (lockstep)",
+                     fontsize=9)
+        report.figure(fig, "zwidth_vs_rate.png", "Z-width against tick rate")
+        report.add(rt.get("zwidth_method", ""))
+        report.add("")
+        report.add(table(["rate Hz", "bound 2b/T N/m", "K max PC off N/m", "K max PC on N/m", "off / bound"],
+                         [[fmt(r["rate_hz"]), fmt(r["colgate_bound_k_n_per_m"]), fmt(r["k_max_passivity_off_n_per_m"]),
+                           fmt(r["k_max_passivity_on_n_per_m"]), fmt(r["ratio_off_to_bound"])] for r in z]))
+        report.add(targets_table([t for t in targets if t.section == "zwidth"]))
+
+
+def section_stress(report, data, problems, targets):
+    report.add("## Stress summary — `fissure stress --profile ci`")
+    report.add("")
+    stress = data.get("stress")
+    if not stress:
+        missing(report, "stress", problems)
+        return
+    cases = stress.get("cases", [])
+    passed = sum(1 for c in cases if c.get("passed"))
+    known = sum(1 for c in cases if not c.get("passed") and c.get("known_failure"))
+    failed = sum(1 for c in cases if not c.get("passed") and not c.get("known_failure"))
+    report.add(f"Profile `{stress.get('profile', '?')}`, base seed {stress.get('base_seed', '?')}: {len(cases)} cases — "
+               f"**{passed} passed, {failed} failed, {known} known failures** — in {fmt(stress.get('wall_s'))} s. Checked on "
+               f"every tick: finite, |F| within the limit, 0 crossed nodes, energy ≤ {fmt(stress.get('energy_bound_j'))} J, only "
+               f"injected faults, recovery within {fmt(stress.get('recovery_bound_s'))} s.")
+    report.add("")
+    groups = {}
+    for c in cases:
+        g = groups.setdefault(c.get("group", "?"), [0, 0, 0])
+        g[0 if c.get("passed") else (2 if c.get("known_failure") else 1)] += 1
+    report.add(table(["group", "passed", "failed", "known failures"], [[g, v[0], v[1], v[2]] for g, v in groups.items()]))
+    rows = []
+    for c in cases:
+        outcome = "pass" if c.get("passed") else ("KNOWN" if c.get("known_failure") else "**FAIL**")
+        rows.append([c.get("name"), c.get("group"), outcome, fmt(c.get("ticks")), fmt(c.get("force_max_n")),
+                     fmt(c.get("energy_max_j")), fmt(c.get("crossed_nodes_max")), c.get("faults_seen", ""),
+                     f"{c.get('recoveries_done', 0)}/{c.get('recoveries_required', 0)}",
+                     "; ".join(c.get("failures", []))[:160]])
+    report.add(table(["case", "group", "outcome", "ticks", "|F| max N", "energy max J", "crossed", "faults seen", "recovered",
+                      "failures"], rows))
+    report.add(targets_table([t for t in targets if t.section == "stress"]))
+
+
+def section_view(report, data, problems, targets):
+    report.add("## Viewer cost — `fissure bench view`")
+    report.add("")
+    view = data.get("view")
+    if not view:
+        missing(report, "view", problems)
+        return
+    report.add(f"Host step time of `{view.get('scene', '?')}` paced at the real host rate, {view.get('repeats', '?')} "
+               "repeat(s) per row: nothing drawn, snapshots published, frames written, the window (when a display exists).")
+    report.add("")
+    report.add(table(["configuration", "step median µs", "step p99 µs", "publish median µs", "frames written", "frames dropped"],
+                     [[r.get("configuration"), fmt(r.get("host_step_us", {}).get("median")),
+                       fmt(r.get("host_step_us", {}).get("p99")), fmt(r.get("capture_publish_us", {}).get("median")),
+                       fmt(r.get("frames_written")), fmt(r.get("frames_dropped"))] for r in view.get("rows", [])]))
+    report.add(targets_table([t for t in targets if t.section == "view"]))
+
+
+SECTIONS = [section_pareto, section_tunnelling, section_scaling, section_rt, section_stress, section_view]
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("directory", help="the --out directory of fissure bench all")
+    parser.add_argument("--md", help="report file (default DIR/report.md)")
+    parser.add_argument("--images", help="directory for the PNGs (default DIR)")
+    args = parser.parse_args()
+    md = args.md or os.path.join(args.directory, "report.md")
+    images = args.images or args.directory
+    os.makedirs(images, exist_ok=True)
+    os.makedirs(os.path.dirname(os.path.abspath(md)), exist_ok=True)
+    data, problems = load_inputs(args.directory)
+    targets = evaluate_all(data)
+    report = Report(md, images)
+    section_header(report, data, problems, targets)
+    broken = []
+    for section in SECTIONS:
+        try:
+            section(report, data, problems, targets)
+        except (KeyError, TypeError, ValueError, IndexError, AttributeError) as e:
+            # A benchmark changed its JSON: say so in the report and on stderr, keep the rest.
+            name = section.__name__.replace("section_", "")
+            message = f"{type(e).__name__}: {e}"
+            broken.append(f"{name}: {message}")
+            report.add(f"*Section `{name}` could not be made from the JSON ({message}).*")
+            report.add("")
+            plt.close("all")
+    with open(md, "w") as f:
+        f.write(report.text())
+    print(f"make_report.py: wrote {md} and {len(report.images)} plots in {images}")
+    for b in broken:
+        print(f"make_report.py: section {b}", file=sys.stderr)
+    return 1 if broken else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
