@@ -202,7 +202,7 @@ std::optional<host::SceneCollisionMethod> run_pass(const RenderOptions& o, const
       sinks.window->exchange().publish(*snapshot);
     }
     if (sinks.unread != nullptr) sinks.unread->publish(*snapshot);
-    if (frame_due) sinks.frames->exchange().publish(*snapshot);
+    if (frame_due) sinks.frames->publish(*snapshot);
     out.publish_s.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
     if (frame_due && o.wait_for_frames) sinks.frames->wait_until_written(snapshot->sequence);
   }
@@ -269,7 +269,11 @@ RenderOutcome run_render(const RenderOptions& o) {
     }
     if (o.view) {
       std::string why_not;
-      window = viewer::ViewWindow::open(m, o.width_px, o.height_px, why_not);
+      viewer::ViewWindowOptions wo;
+      wo.width_px = o.width_px;
+      wo.height_px = o.height_px;
+      wo.method_switching = true;  // run_pass restarts with the next method on M
+      window = viewer::ViewWindow::open(m, wo, why_not);
       if (!window) {
         std::printf("%s\n", why_not.c_str());
       } else {

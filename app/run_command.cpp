@@ -32,6 +32,11 @@ struct RunOptions {
   bool no_plot = false;
   bool no_passivity_controller = false;
   bool quiet = false;
+  bool view = false;
+  std::string frames_dir;
+  int frame_every = 10;
+  int width_px = 960;
+  int height_px = 720;
 };
 
 void run(const RunOptions& options) {
@@ -53,6 +58,11 @@ void run(const RunOptions& options) {
   session.plot = !options.no_plot;
   session.passivity_controller = !options.no_passivity_controller;
   session.status_line = !options.quiet;
+  session.view = options.view;
+  session.frames_dir = options.frames_dir;
+  session.frame_every = options.frame_every;
+  session.frame_width_px = options.width_px;
+  session.frame_height_px = options.height_px;
   SessionOutcome outcome;
   {
     const SigintFlag sigint;
@@ -72,6 +82,19 @@ void run(const RunOptions& options) {
               s["proxy_age_ms"]["median"].get<double>(), s["proxy_age_ms"]["p99"].get<double>(),
               s["host_step_ms"]["median"].get<double>(), s["host_step_ms"]["p99"].get<double>(),
               SigintFlag::raised() ? " | stopped by Ctrl-C" : "");
+  if (s.contains("view")) {
+    const nlohmann::json& v = s["view"];
+    if (v["window"]["open"].get<bool>()) {
+      std::printf("  view: %llu frames drawn\n", v["window"]["frames_drawn"].get<unsigned long long>());
+    }
+    if (v.contains("frames")) {
+      const nlohmann::json& fr = v["frames"];
+      std::printf("  frames: %llu written to %s (every %d host steps, %llu dropped), %.1f ms per frame median; capture+publish median %.1f us\n",
+                  fr["written"].get<unsigned long long>(), fr["dir"].get<std::string>().c_str(), fr["every_host_steps"].get<int>(),
+                  fr["dropped"].get<unsigned long long>(), fr["frame_ms"]["median"].get<double>(),
+                  v["capture_publish_us"]["median"].get<double>());
+    }
+  }
   std::printf("  wrote %s, %s%s%s\n", outcome.trace_path.c_str(), outcome.summary_path.c_str(),
               outcome.plot_path.empty() ? "" : ", ", outcome.plot_path.c_str());
 }
@@ -98,6 +121,13 @@ void register_run(CommandTree& tree) {
   cmd->add_flag("--no-passivity-controller", options->no_passivity_controller,
                 "diagnosis: rt_core's passivity controller off (the energy observer still runs)");
   cmd->add_flag("--quiet", options->quiet, "no status line");
+  cmd->add_flag("--view", options->view,
+                "live 3-D window (GLFW, own thread, never blocks the host or rt); without a display it says so and runs on");
+  cmd->add_option("--frames", options->frames_dir,
+                  "write PNG frames here (headless OpenGL, own thread; real time drops frames it has no time for, lockstep writes each)");
+  cmd->add_option("--frame-every", options->frame_every, "host steps between frames")->check(CLI::PositiveNumber);
+  cmd->add_option("--width", options->width_px, "frame / window width [px]")->check(CLI::Range(64, 4096));
+  cmd->add_option("--height", options->height_px, "frame / window height [px]")->check(CLI::Range(64, 4096));
   cmd->callback([options] { run(*options); });
 }
 

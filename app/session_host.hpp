@@ -47,6 +47,8 @@ class SessionHost {
 
   [[nodiscard]] const HostStatus& status() const noexcept { return status_; }
   [[nodiscard]] const host::HostSimulation& simulation() const noexcept { return sim_; }
+  /// The view builds its picture's model from the settled simulation (before the session runs).
+  [[nodiscard]] host::HostSimulation& simulation() noexcept { return sim_; }
   [[nodiscard]] const ContactProxy& last_proxy() const noexcept { return proxy_; }
   [[nodiscard]] double time_step_s() const noexcept { return scene_.simulation.time_step_s; }
 

@@ -44,6 +44,7 @@ SessionRecorder::SessionRecorder(const std::filesystem::path& out_dir, std::size
                "fault_bits,overruns,host_time_s,host_force_n,host_contacts,host_crossed_nodes,host_penetration_m\n");
   figures_.proxy_age_ms.reserve(expected_ticks);
   figures_.host_step_ms.reserve(expected_host_steps);
+  figures_.tick_interval_us.reserve(expected_ticks);
 }
 
 SessionRecorder::~SessionRecorder() { close_trace(); }
@@ -63,6 +64,7 @@ void SessionRecorder::add_host_step(const HostStatus& host) {
 }
 
 void SessionRecorder::add_tick(const rt::TelemetrySample& s, const HostStatus& host) {
+  if (figures_.telemetry_samples > 0) figures_.tick_interval_us.push_back(static_cast<double>(s.time_ns - last_.time_ns) * 1e-3);
   last_ = s;
   if (figures_.telemetry_samples++ == 0) figures_.first_tick_time_ns = s.time_ns;
   figures_.last_tick_time_ns = s.time_ns;

@@ -35,6 +35,9 @@ struct SessionFigures {
   std::uint64_t host_steps = 0;
   std::vector<double> proxy_age_ms;        ///< per tick with a proxy
   std::vector<double> host_step_ms;        ///< per host step
+  /// Loop-clock time between consecutive telemetry samples [us]: the rt tick period as it
+  /// happened (its jitter is what competition for the CPU, e.g. the view, would show up in).
+  std::vector<double> tick_interval_us;
 };
 
 class SessionRecorder {
@@ -51,6 +54,8 @@ class SessionRecorder {
   void close_trace();
 
   [[nodiscard]] const SessionFigures& figures() const noexcept { return figures_; }
+  /// The newest telemetry sample added (zeros before the first).
+  [[nodiscard]] const rt::TelemetrySample& last_tick() const noexcept { return last_; }
   [[nodiscard]] const std::filesystem::path& trace_path() const noexcept { return trace_path_; }
   [[nodiscard]] const std::filesystem::path& out_dir() const noexcept { return out_dir_; }
 

@@ -26,6 +26,8 @@
 #include "fissure/rt_core/rt_thread.hpp"
 #include "fissure/shared/clock.hpp"
 #include "fissure/shared/spsc_ring.hpp"
+#include "fissure/viewer/render_snapshot.hpp"
+#include "fissure/viewer/session_view.hpp"
 #include "session_host.hpp"
 
 namespace fissure::app {
@@ -93,6 +95,38 @@ class StatusPrinter {
   std::uint64_t last_host_steps_ = 0;
 };
 
+// The rt side of the view's overlay, from the telemetry drained so far. Tick rate over windows
+// of at least kRateWindow_s of loop-clock time (one 10 ms drain is too short to read steadily).
+class RtFiguresTracker {
+ public:
+  static constexpr double kRateWindow_s = 0.25;
+  viewer::RtFigures update(const SessionRecorder& recorder) {
+    const rt::TelemetrySample& s = recorder.last_tick();
+    if (recorder.figures().telemetry_samples == 0) return figures_;
+    if (!started_) {
+      started_ = true;
+      window_tick_ = s.tick;
+      window_start_ns_ = s.time_ns;
+    }
+    const double span_s = to_seconds(s.time_ns - window_start_ns_);
+    if (span_s >= kRateWindow_s) {
+      figures_.tick_rate_hz = static_cast<double>(s.tick - window_tick_) / span_s;
+      window_tick_ = s.tick;
+      window_start_ns_ = s.time_ns;
+    }
+    figures_.force_n = as_eigen(s.force_device_n).norm();
+    figures_.proxy_age_ms = s.proxy_sequence != 0 ? static_cast<double>(s.proxy_age_ns) * 1e-6 : std::numeric_limits<double>::quiet_NaN();
+    figures_.overruns = static_cast<std::int64_t>(s.overruns);
+    return figures_;
+  }
+
+ private:
+  bool started_ = false;
+  std::uint64_t window_tick_ = 0;
+  TimeNs window_start_ns_ = 0;
+  viewer::RtFigures figures_{};
+};
+
 bool interrupted(const SessionOptions& options) {
   return options.interrupt != nullptr && options.interrupt->load(std::memory_order_relaxed);
 }
@@ -150,6 +184,32 @@ SessionOutcome run_session(const SessionOptions& options) {
   host.settle(options.settle_s);
 
   const double expected_s = until_interrupted ? 60.0 : duration_s + 1.0;
+  // The view's picture model is built from the settled body (its rest shape is what the
+  // deformation colours are measured from); the sinks start before the first tick.
+  std::unique_ptr<viewer::SessionView> view;
+  if (options.view || !options.frames_dir.empty()) {
+    viewer::SessionViewOptions vo;
+    vo.window = options.view;
+    vo.window_options.width_px = options.frame_width_px;
+    vo.window_options.height_px = options.frame_height_px;
+    vo.window_options.method_switching = false;  // a session cannot swap its method under the hand
+    vo.window_options.screenshot_dir = options.out_dir;
+    vo.frames_dir = options.frames_dir;
+    vo.frame_every_steps = options.frame_every;
+    vo.frame_width_px = options.frame_width_px;
+    vo.frame_height_px = options.frame_height_px;
+    vo.wait_for_frames = options.lockstep;
+    vo.expected_host_steps = static_cast<std::size_t>(expected_s / host_dt_s);
+    std::string error, notice;
+    try {
+      view = viewer::SessionView::start(viewer::make_render_model(host.simulation()), vo, error, notice);
+    } catch (const std::exception& e) {
+      throw CommandError(std::string("--view/--frames: ") + e.what());
+    }
+    if (!view) throw CommandError("--frames: " + error);
+    if (!notice.empty()) std::fprintf(stderr, "%s\n", notice.c_str());
+  }
+  RtFiguresTracker rt_figures;
   SessionRecorder recorder(options.out_dir, static_cast<std::size_t>(expected_s * options.rt_rate_hz),
                            static_cast<std::size_t>(expected_s / host_dt_s));
   auto exchanges = std::make_unique<Exchanges>();
@@ -160,6 +220,7 @@ SessionOutcome run_session(const SessionOptions& options) {
   std::uint64_t proxies_rejected = 0;
   std::uint64_t host_late_steps = 0;
   std::uint64_t host_status_dropped = 0;
+  double wakeup_median_us = 0.0;
   double wakeup_p99_us = 0.0;
   double wakeup_max_us = 0.0;
   double max_tick_us = 0.0;
@@ -187,6 +248,10 @@ SessionOutcome run_session(const SessionOptions& options) {
       const HostStatus& host_status = host.step(exchanges->state, exchanges->proxy);
       recorder.add_host_step(host_status);
       while (exchanges->telemetry.try_pop(sample)) recorder.add_tick(sample, host_status);
+      if (view) {
+        view->rt_figures().publish(rt_figures.update(recorder));
+        view->on_host_step(host.simulation(), &host.last_proxy());
+      }
       session_time_s = to_seconds(clock.now());
       status.maybe_print(recorder, session_time_s, recorder.figures().ticks, recorder.figures().host_steps);
     }
@@ -232,6 +297,8 @@ SessionOutcome run_session(const SessionOptions& options) {
         try {
           const HostStatus& st = host.step(exchanges->state, exchanges->proxy);
           if (!exchanges->host_status.try_push(st)) dropped.fetch_add(1, std::memory_order_relaxed);
+          // Wait-free hand-off to the window / frame writer threads (never waits in real time).
+          if (view) view->on_host_step(host.simulation(), &host.last_proxy());
         } catch (const std::exception& e) {
           host_error = e.what();
           stop_rt.store(true);  // the proxy goes stale and fades; ramp out and stop
@@ -261,6 +328,7 @@ SessionOutcome run_session(const SessionOptions& options) {
       std::this_thread::sleep_for(std::chrono::milliseconds(kDrainPeriod_ms));
       if (interrupted(options)) stop_rt.store(true);
       drain();
+      if (view) view->rt_figures().publish(rt_figures.update(recorder));
       session_time_s = to_seconds(clock.now() - start_ns);
       status.maybe_print(recorder, session_time_s, recorder.figures().ticks, recorder.figures().host_steps);
     }
@@ -272,6 +340,7 @@ SessionOutcome run_session(const SessionOptions& options) {
     proxies_rejected = loop.data().proxy.rejected_count;
     host_late_steps = late.load();
     host_status_dropped = dropped.load();
+    wakeup_median_us = loop.stats().wakeup.quantile_us(0.5);
     wakeup_p99_us = loop.stats().wakeup.quantile_us(0.99);
     wakeup_max_us = loop.stats().wakeup.quantile_us(1.0);
     max_tick_us = static_cast<double>(loop.stats().max_tick_ns) * 1e-3;
@@ -283,6 +352,8 @@ SessionOutcome run_session(const SessionOptions& options) {
   }
   status.finish();
   recorder.close_trace();
+  std::optional<viewer::SessionViewStats> view_stats;
+  if (view) view_stats = view->finish();
   const double wall_s = std::chrono::duration<double>(WallClock::now() - wall_start).count();
 
   const SessionFigures& f = recorder.figures();
@@ -319,8 +390,34 @@ SessionOutcome run_session(const SessionOptions& options) {
   summary["host_late_steps"] = host_late_steps;
   summary["host_status_dropped"] = host_status_dropped;
   if (!options.lockstep) {
-    summary["wakeup_latency_us"] = {{"p99", wakeup_p99_us}, {"max", wakeup_max_us}};
+    summary["wakeup_latency_us"] = {{"median", wakeup_median_us}, {"p99", wakeup_p99_us}, {"max", wakeup_max_us}};
     summary["max_tick_us"] = max_tick_us;
+    std::vector<double> intervals = f.tick_interval_us;
+    summary["tick_interval_us"] = quantile_json(std::move(intervals));
+  }
+  if (view_stats) {
+    nlohmann::json v;
+    v["window"] = {{"requested", options.view}, {"open", view_stats->window_open}, {"frames_drawn", view_stats->window_frames}};
+    if (!options.frames_dir.empty()) {
+      v["frames"] = {{"dir", options.frames_dir.string()},
+                     {"every_host_steps", options.frame_every},
+                     {"published", view_stats->frames_published},
+                     {"written", view_stats->frames_written},
+                     {"dropped", view_stats->frames_dropped},
+                     {"waited_for", options.lockstep},
+                     {"frame_ms", quantile_json([&] {
+                        std::vector<double> ms;
+                        for (const double t : view_stats->frame_s) ms.push_back(t * 1e3);
+                        return ms;
+                      }())},
+                     {"gl", view_stats->gl_description},
+                     {"error", view_stats->frames_error}};
+    }
+    std::vector<double> publish_us;
+    for (const double t : view_stats->capture_publish_s) publish_us.push_back(t * 1e6);
+    v["capture_publish_us"] = quantile_json(std::move(publish_us));
+    summary["view"] = v;
+    if (!view_stats->frames_error.empty()) spdlog::error("--frames: {}", view_stats->frames_error);
   }
   summary["telemetry_samples"] = f.telemetry_samples;
   for (const auto& [key, value] : extra.items()) summary[key] = value;

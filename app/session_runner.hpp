@@ -41,6 +41,15 @@ struct SessionOptions {
   /// energy comes from: with it off the summary's energy_j is the rendered contact's own.
   bool passivity_controller = true;
   bool status_line = true;
+  /// The view (issue 8): a live window (--view; no display → one line, the session runs on)
+  /// and/or PNG frames of every frame_every-th host step into frames_dir (headless EGL, a
+  /// writer thread; real time never waits for it and counts the frames it dropped, lockstep
+  /// waits so the frames are the same on every run). Neither changes the physics.
+  bool view = false;
+  std::filesystem::path frames_dir;
+  int frame_every = 10;
+  int frame_width_px = 960;
+  int frame_height_px = 720;
   /// Set from a signal handler: ramp out and stop (checked ~every 10 ms in real time, every
   /// host step in lockstep).
   const std::atomic<bool>* interrupt = nullptr;

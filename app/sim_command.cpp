@@ -19,6 +19,8 @@
 #include "fissure/host_sim/scene_loader.hpp"
 #include "fissure/host_sim/thin_tool.hpp"
 #include "fissure/host_sim/tool_mesh_io.hpp"
+#include "fissure/viewer/render_snapshot.hpp"
+#include "fissure/viewer/session_view.hpp"
 #include "sim_report.hpp"
 
 namespace fissure::app {
@@ -65,6 +67,10 @@ struct SimOptions {
   std::string json_path;
   std::string csv_path;
   std::string write_meshes_dir;
+  std::string frames_dir;
+  int frame_every = 10;
+  int width_px = 960;
+  int height_px = 720;
 };
 
 std::optional<host::SceneCollisionMethod> parse_method(const std::string& name) {
@@ -110,6 +116,25 @@ void run_sim(const SimOptions& options) {
   const double duration_s = options.seconds > 0.0 ? options.seconds : host::trajectory_duration_s(scene);
   const double dt = scene.simulation.time_step_s;
   const long steps = std::max(1L, std::lround(duration_s / dt));
+  // --frames: PNGs of every frame_every-th step, drawn by viewer/'s writer thread from the
+  // settled body's picture model. Offline, so each frame is waited for (none dropped).
+  std::unique_ptr<viewer::SessionView> view;
+  if (!options.frames_dir.empty()) {
+    viewer::SessionViewOptions vo;
+    vo.frames_dir = options.frames_dir;
+    vo.frame_every_steps = options.frame_every;
+    vo.frame_width_px = options.width_px;
+    vo.frame_height_px = options.height_px;
+    vo.wait_for_frames = true;
+    vo.expected_host_steps = static_cast<std::size_t>(steps);
+    std::string error, notice;
+    try {
+      view = viewer::SessionView::start(viewer::make_render_model(*sim), vo, error, notice);
+    } catch (const std::exception& e) {
+      throw CommandError(std::string("--frames: ") + e.what());
+    }
+    if (!view) throw CommandError("--frames: " + error);
+  }
   std::printf("scene %s: %s, method %s, %d faces / %d nodes, %ld steps of %.3g ms\n", scene.name.c_str(), scene.description.c_str(),
               host::to_string(sim->method()), sim->soft_face_count(), sim->soft_node_count(), steps, dt * 1e3);
   SimProgress progress("sim " + scene.name, steps);
@@ -122,6 +147,7 @@ void run_sim(const SimOptions& options) {
   for (long i = 0; i < steps; ++i) {
     const host::TrajectorySample target = sim->scripted_target();
     const host::HostStepResult& r = sim->step(host::to_tool_pose(target.pose), target.jaw_gap_m);
+    if (view) view->on_host_step(*sim, nullptr);
     step_s.push_back(r.times.total_s);
     collision_s.push_back(r.times.collision_s);
     const double f = r.force_on_tool_world_n.norm();
@@ -147,6 +173,14 @@ void run_sim(const SimOptions& options) {
     }
   }
   progress.finish("");
+  std::optional<viewer::SessionViewStats> frames;
+  if (view) {
+    frames = view->finish();
+    if (!frames->frames_error.empty()) throw CommandError("--frames: " + frames->frames_error);
+    std::printf("frames: %llu written to %s (every %d steps), %.1f ms per frame median [%s]\n",
+                static_cast<unsigned long long>(frames->frames_written), options.frames_dir.c_str(), options.frame_every,
+                sim_quantile(frames->frame_s, 0.5) * 1e3, frames->gl_description.c_str());
+  }
   double mean = 0.0, var = 0.0;
   for (double f : force_in_contact) mean += f;
   mean = force_in_contact.empty() ? 0.0 : mean / static_cast<double>(force_in_contact.size());
@@ -178,6 +212,10 @@ void run_sim(const SimOptions& options) {
                   {"steps_in_contact", force_in_contact.size()}, {"all_finite", finite}};
     j["step_time_us"] = {{"median", median_us}, {"p99", p99_us}};
     j["collision_time_us"] = {{"median", sim_quantile(collision_s, 0.5) * 1e6}, {"p99", sim_quantile(collision_s, 0.99) * 1e6}};
+    if (frames) {
+      j["frames"] = {{"dir", options.frames_dir}, {"every_steps", options.frame_every}, {"written", frames->frames_written},
+                     {"dropped", frames->frames_dropped}, {"frame_ms_median", sim_quantile(frames->frame_s, 0.5) * 1e3}};
+    }
     j["machine"] = sim_machine_info();
     std::ofstream out(options.json_path);
     if (!out) throw CommandError("cannot write the JSON summary '" + options.json_path + "'");
@@ -197,6 +235,10 @@ void register_sim(CommandTree& tree) {
   sim->add_option("--json", options->json_path, "Write the summary JSON here");
   sim->add_option("--csv", options->csv_path, "Write the per-step trace CSV here");
   sim->add_option("--write-meshes", options->write_meshes_dir, "Regenerate the shipped tool meshes (OBJ) into this directory");
+  sim->add_option("--frames", options->frames_dir, "Write PNG frames (headless OpenGL, no display needed) into this directory");
+  sim->add_option("--frame-every", options->frame_every, "Steps between frames")->check(CLI::PositiveNumber);
+  sim->add_option("--width", options->width_px, "Frame width [px]")->check(CLI::Range(64, 4096));
+  sim->add_option("--height", options->height_px, "Frame height [px]")->check(CLI::Range(64, 4096));
   sim->callback([options] { run_sim(*options); });
 }
 

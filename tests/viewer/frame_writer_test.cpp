@@ -29,7 +29,7 @@ TEST(FrameWriter, WritesOnePngPerWaitedSnapshot) {
   for (int i = 0; i < 3; ++i) {
     (void)sim.step(host::to_tool_pose(sim.scene().trajectory.start));
     capture_snapshot(sim, *snapshot);
-    writer->exchange().publish(*snapshot);
+    writer->publish(*snapshot);
     writer->wait_until_written(snapshot->sequence);
     EXPECT_EQ(writer->frames_written(), static_cast<std::uint64_t>(i + 1));
   }

@@ -13,7 +13,10 @@ TEST(ViewWindow, NoDisplaySaysSoInOneLine) {
   ::unsetenv("WAYLAND_DISPLAY");
   RenderModel model;
   std::string why_not;
-  EXPECT_EQ(ViewWindow::open(model, 640, 480, why_not), nullptr);
+  ViewWindowOptions options;
+  options.width_px = 640;
+  options.height_px = 480;
+  EXPECT_EQ(ViewWindow::open(model, options, why_not), nullptr);
   EXPECT_NE(why_not.find("--view"), std::string::npos);
   EXPECT_NE(why_not.find("display"), std::string::npos);
   EXPECT_EQ(why_not.find('\n'), std::string::npos);

@@ -168,22 +168,26 @@ void OffscreenContext::read_frame(RgbaImage& out) {
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo_);
   glBlitFramebuffer(0, 0, width_, height_, 0, 0, width_, height_, GL_COLOR_BUFFER_BIT, GL_NEAREST);
   glBindFramebuffer(GL_READ_FRAMEBUFFER, resolve_fbo_);
-  out.width = width_;
-  out.height = height_;
-  out.pixels.resize(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 4);
+  read_bound_framebuffer(width_, height_, out);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+void read_bound_framebuffer(int width_px, int height_px, RgbaImage& out) {
+  out.width = width_px;
+  out.height = height_px;
+  out.pixels.resize(static_cast<std::size_t>(width_px) * static_cast<std::size_t>(height_px) * 4);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadPixels(0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, out.pixels.data());
+  glReadPixels(0, 0, width_px, height_px, GL_RGBA, GL_UNSIGNED_BYTE, out.pixels.data());
   // GL's rows run bottom to top; images run top to bottom.
-  const std::size_t row = static_cast<std::size_t>(width_) * 4;
+  const std::size_t row = static_cast<std::size_t>(width_px) * 4;
   std::vector<std::uint8_t> swap(row);
-  for (int y = 0; y < height_ / 2; ++y) {
+  for (int y = 0; y < height_px / 2; ++y) {
     std::uint8_t* a = &out.pixels[static_cast<std::size_t>(y) * row];
-    std::uint8_t* b = &out.pixels[static_cast<std::size_t>(height_ - 1 - y) * row];
+    std::uint8_t* b = &out.pixels[static_cast<std::size_t>(height_px - 1 - y) * row];
     std::memcpy(swap.data(), a, row);
     std::memcpy(a, b, row);
     std::memcpy(b, swap.data(), row);
   }
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
 }  // namespace fissure::viewer

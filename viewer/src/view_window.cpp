@@ -1,9 +1,16 @@
 // The GLFW window thread (see view_window.hpp).
 #include "fissure/viewer/view_window.hpp"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <exception>
 
+#include "fissure/viewer/offscreen_context.hpp"
 #include "fissure/viewer/scene_renderer.hpp"
 
 #if defined(FISSURE_VIEWER_HAS_GLFW)
@@ -14,15 +21,19 @@
 
 namespace fissure::viewer {
 
-ViewWindow::ViewWindow(const RenderModel& model, int width_px, int height_px)
-    : model_(model), width_px_(width_px), height_px_(height_px), exchange_(std::make_unique<SnapshotExchange>()),
-      camera_(default_camera(model_)) {}
+ViewWindow::ViewWindow(const RenderModel& model, const ViewWindowOptions& options)
+    : model_(model), options_(options), exchange_(std::make_unique<SnapshotExchange>()), camera_(default_camera(model_)) {}
 
-std::unique_ptr<ViewWindow> ViewWindow::open(const RenderModel& model, int width_px, int height_px, std::string& why_not) {
+std::filesystem::path ViewWindow::screenshot_path(std::uint64_t n) const {
+  char name[32];
+  std::snprintf(name, sizeof name, "view_%03llu.png", static_cast<unsigned long long>(n));
+  return options_.screenshot_dir / name;
+}
+
+std::unique_ptr<ViewWindow> ViewWindow::open(const RenderModel& model, const ViewWindowOptions& options, std::string& why_not) {
 #if !defined(FISSURE_VIEWER_HAS_GLFW)
   (void)model;
-  (void)width_px;
-  (void)height_px;
+  (void)options;
   why_not = "--view: this build has no GLFW (install libglfw3-dev and reconfigure); running without the view";
   return nullptr;
 #else
@@ -32,7 +43,7 @@ std::unique_ptr<ViewWindow> ViewWindow::open(const RenderModel& model, int width
     why_not = "--view: no display (DISPLAY and WAYLAND_DISPLAY are unset); running without the view";
     return nullptr;
   }
-  std::unique_ptr<ViewWindow> window(new ViewWindow(model, width_px, height_px));
+  std::unique_ptr<ViewWindow> window(new ViewWindow(model, options));
   std::atomic<int> ready{0};
   std::string error;
   window->thread_ = std::thread([w = window.get(), &ready, &error] { w->run(ready, error); });
@@ -58,6 +69,7 @@ void ViewWindow::on_key(int key, int action) noexcept {
     case GLFW_KEY_SPACE: paused_.store(!paused_.load(std::memory_order_relaxed), std::memory_order_relaxed); break;
     case GLFW_KEY_M: method_switches_.fetch_add(1, std::memory_order_relaxed); break;
     case GLFW_KEY_R: camera_ = default_camera(model_); break;
+    case GLFW_KEY_F12: screenshot_requested_ = true; break;
     case GLFW_KEY_ESCAPE:
     case GLFW_KEY_Q: stop_.store(true, std::memory_order_release); break;
     default: break;
@@ -85,8 +97,37 @@ void ViewWindow::on_button(int button, int action) noexcept {
 
 void ViewWindow::on_scroll(double steps) noexcept { camera_.zoom(static_cast<float>(steps)); }
 
+void ViewWindow::write_screenshot(int width_px, int height_px) noexcept {
+#if defined(FISSURE_VIEWER_HAS_GLFW)
+  // The back buffer still holds the frame just drawn (before the swap).
+  const std::filesystem::path path = screenshot_path(screenshots_.load(std::memory_order_relaxed));
+  try {
+    std::filesystem::create_directories(options_.screenshot_dir);
+    RgbaImage image;
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+    glReadBuffer(GL_BACK);
+    read_bound_framebuffer(width_px, height_px, image);
+    write_png(image, path.string());
+    screenshots_.fetch_add(1, std::memory_order_relaxed);
+    std::fprintf(stderr, "view: wrote %s (%d x %d)\n", path.c_str(), width_px, height_px);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "view: F12 picture not written: %s\n", e.what());
+  }
+#else
+  (void)width_px;
+  (void)height_px;
+#endif
+}
+
 void ViewWindow::run(std::atomic<int>& ready, std::string& why_not) noexcept {
 #if defined(FISSURE_VIEWER_HAS_GLFW)
+  if (options_.nice_increment > 0) {
+    // Per-thread nice (Linux), set before GL starts any helper threads so they inherit it.
+    const auto tid = static_cast<id_t>(::gettid());
+    errno = 0;
+    const int current = ::getpriority(PRIO_PROCESS, tid);
+    if (errno == 0) (void)::setpriority(PRIO_PROCESS, tid, current + options_.nice_increment);
+  }
   auto fail = [&](const std::string& reason) {
     why_not = reason;
     ready.store(-1, std::memory_order_release);
@@ -105,7 +146,7 @@ void ViewWindow::run(std::atomic<int>& ready, std::string& why_not) noexcept {
   glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
   glfwWindowHint(GLFW_SAMPLES, 4);
   const std::string title = "fissure - " + model_.scene_name;
-  GLFWwindow* window = glfwCreateWindow(width_px_, height_px_, title.c_str(), nullptr, nullptr);
+  GLFWwindow* window = glfwCreateWindow(options_.width_px, options_.height_px, title.c_str(), nullptr, nullptr);
   if (window == nullptr) {
     const char* description = nullptr;
     glfwGetError(&description);
@@ -137,18 +178,32 @@ void ViewWindow::run(std::atomic<int>& ready, std::string& why_not) noexcept {
   ready.notify_all();
 
   auto snapshot = std::make_unique<RenderSnapshot>();
+  const char* help = options_.method_switching ? "SPACE PAUSE | M METHOD | DRAG ORBIT | WHEEL ZOOM | F12 PNG"
+                                               : "SPACE FREEZE | DRAG ORBIT | WHEEL ZOOM | F12 PNG";
+  const char* paused_help = options_.method_switching ? "PAUSED - SPACE RESUMES | M SWITCHES METHOD" : "FROZEN (SESSION RUNS ON) - SPACE RESUMES";
+  const auto frame_period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(1.0 / kMaxViewRateHz));
+  auto next_frame = std::chrono::steady_clock::now();
   while (!stop_.load(std::memory_order_acquire) && glfwWindowShouldClose(window) == GLFW_FALSE) {
     glfwPollEvents();
-    (void)exchange_->try_fetch(*snapshot);  // keep the last one when nothing new came
+    // Paused: keep drawing the frozen snapshot (the camera still moves).
+    if (!paused()) (void)exchange_->try_fetch(*snapshot);  // keep the last one when nothing new came
     int width = 0, height = 0;
     glfwGetFramebufferSize(window, &width, &height);
     if (width > 0 && height > 0) {
       glBindFramebuffer(GL_FRAMEBUFFER, 0);
-      renderer->draw(*snapshot, camera_, width, height,
-                     paused() ? "PAUSED - SPACE RESUMES | M SWITCHES METHOD" : "SPACE PAUSE | M METHOD | DRAG ORBIT | WHEEL ZOOM");
+      renderer->draw(*snapshot, camera_, width, height, paused() ? paused_help : help);
+      if (screenshot_requested_) write_screenshot(width, height);
     }
+    screenshot_requested_ = false;
     glfwSwapBuffers(window);
     frames_drawn_.fetch_add(1, std::memory_order_relaxed);
+    next_frame += frame_period;
+    const auto now = std::chrono::steady_clock::now();
+    if (next_frame > now) {
+      std::this_thread::sleep_until(next_frame);
+    } else {
+      next_frame = now;  // behind (slow draw): no burst of catch-up frames
+    }
   }
   closed_.store(true, std::memory_order_relaxed);
   renderer.reset();

@@ -43,6 +43,11 @@ class OffscreenContext {
   std::string description_;
 };
 
+/// Reads width × height pixels from the current context's bound read framebuffer (and read
+/// buffer) into `out`, rows top to bottom (GL's run bottom to top). Used for the offscreen
+/// frames and for the window's F12 picture of its back buffer.
+void read_bound_framebuffer(int width_px, int height_px, RgbaImage& out);
+
 /// Writes an RGBA image as an 8-bit RGB PNG. Throws std::runtime_error naming the file.
 void write_png(const RgbaImage& image, const std::string& path);
 /// Reads a PNG into RGBA. Throws std::runtime_error naming the file.
