@@ -47,9 +47,6 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision {
     out.seconds_narrow = out.seconds_response = out.seconds_force = 0.0;
 
     make_frame(previous, current, dt_s);
-    // Out of contact and far from the body the stale leaves cannot matter (see refit_node_tree):
-    // skip the O(nodes) check there so that out of contact the cost stays one root test.
-    if (!leaves_tightened_ || had_contact_ || root_near_tool(soft)) refit_node_tree(soft);
     out.broad_phase_hit = thin_body::broad_phase(model_, frame_, soft, data_);
     const Clock::time_point t1 = Clock::now();
     out.seconds_broad = seconds_between(t0, t1);
@@ -89,51 +86,6 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision {
   }
 
  private:
-  // Whether the node tree's root comes within the broad phase's reach of the swept tool. A leaf
-  // can only be stale by the solver's correction of one step, which is large only for nodes this
-  // collision displaced (had_contact_ covers those) — elsewhere the root is a safe first test.
-  bool root_near_tool(const btSoftBody& soft) const {
-    const btDbvtNode* root = soft.m_ndbvt.m_root;
-    if (root == nullptr) return true;
-    const double reach = model_.params.broad_phase_margin_m + 2.0 * model_.soft.max_rest_edge_m;
-    const btVector3& lo = root->volume.Mins();
-    const btVector3& hi = root->volume.Maxs();
-    const Eigen::AlignedBox3d& box = frame_.swept_tool_world_m;
-    return lo.x() <= box.max().x() + reach && hi.x() >= box.min().x() - reach && lo.y() <= box.max().y() + reach &&
-           hi.y() >= box.min().y() - reach && lo.z() <= box.max().z() + reach && hi.z() >= box.min().z() - reach;
-  }
-
-  // The broad phase walks the soft body's node tree, so every leaf must cover the node's ACTUAL
-  // start (m_q) and end (m_x) positions. Bullet does not guarantee that:
-  //  * it inserts each leaf with the collision margin in force at creation (0.25 m by default,
-  //    usually reduced afterwards) and never shrinks a leaf that still contains its node, so the
-  //    first step re-fits every leaf to the current margin (else the broad phase is 0.25 m loose);
-  //  * it refits a leaf in predictMotion around the PREDICTED position m_q + v·dt, before the
-  //    links and contacts move the node. A node this collision displaced last step carries the
-  //    tool's velocity; when the tool stops (or jumps) the prediction lands centimetres away from
-  //    where the solver leaves the node, the leaf misses the tool's query box, the node is never a
-  //    candidate and nothing stops it going through the tool (measured: 3 nodes of the 128-face
-  //    ball 3 cm above a 4 mm plate after a 150 mm single step in HostSimulation).
-  // So each step near the body every leaf is checked (two containment tests per node) and
-  // refitted only when it does not contain both positions; Bullet's next predictMotion grows it
-  // again as it needs.
-  void refit_node_tree(btSoftBody& soft) {
-    const btScalar margin = soft.getCollisionShape()->getMargin();
-    const bool first = !leaves_tightened_;
-    for (int i = 0; i < soft.m_nodes.size(); ++i) {
-      btSoftBody::Node& node = soft.m_nodes[i];
-      if (node.m_leaf == nullptr) continue;
-      const btDbvtVolume& leaf = node.m_leaf->volume;
-      if (!first && leaf.Contain(btDbvtVolume::FromCR(node.m_x, 0)) && leaf.Contain(btDbvtVolume::FromCR(node.m_q, 0))) continue;
-      btDbvtVolume volume = btDbvtVolume::FromCR(node.m_x, margin);
-      const btDbvtVolume start = btDbvtVolume::FromCR(node.m_q, margin);
-      btDbvtVolume merged;
-      Merge(volume, start, merged);
-      soft.m_ndbvt.update(node.m_leaf, merged);
-    }
-    leaves_tightened_ = true;
-  }
-
   void make_frame(const ToolPose& previous, const ToolPose& current, double dt_s) {
     frame_.step = data_.step;
     frame_.dt_s = dt_s;
@@ -158,7 +110,6 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision {
   thin_body::StepFrame frame_;
   const btSoftBody* soft_;
   bool had_contact_ = false;
-  bool leaves_tightened_ = false;
 };
 
 }  // namespace

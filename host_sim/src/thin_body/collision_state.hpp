@@ -103,6 +103,15 @@ struct CollisionData {
   std::vector<std::int64_t> hc_stamp;   // last step the face was in contact (filter state valid)
   std::vector<double> hc_x_prev_m;
   std::vector<double> hc_rate_filtered_m_s;
+
+  // ---- Broad phase only (broad_phase.cpp; sized on its first call) ----------------------------
+  bool broad_leaves_fitted = false;                  // node-tree leaves re-fitted once to the real margin
+  std::vector<std::int64_t> broad_listed_stamp;      // soft node listed in candidate_nodes at this step
+  std::vector<int> broad_previous_candidates;        // last step's candidate nodes (re-tested directly)
+  // What the last call visited (tests and the bench count these instead of timing them).
+  int broad_tree_nodes_visited = 0;   // node-tree nodes (internal + leaves) whose volume was tested
+  int broad_seed_nodes = 0;           // soft nodes whose own start/end box met the query
+  int broad_faces_tested = 0;         // soft faces whose tool-frame swept box was tested
 };
 
 CollisionModel build_collision_model(const ToolNodes& tool, const btSoftBody& soft,
@@ -112,7 +121,8 @@ void allocate_collision_data(const CollisionModel& model, CollisionData& data);
 
 // Stage 1 (broad_phase.cpp): swept tool bounds vs the soft body's node tree; on a hit, collects
 // candidate soft nodes / faces and their tool-frame start / end positions. false = out of contact.
-bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data);
+// Non-const body: the first call re-fits the node tree's leaves (once, see broad_phase.cpp).
+bool broad_phase(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft, CollisionData& data);
 // Stage 2 (node_sweep.cpp): every tool node against the candidate triangles, swept over the step.
 void sweep_tool_nodes(const CollisionModel& model, CollisionData& data);
 // Stage 3 (pair_exclusion.cpp): infeasible pairs → exclusion vector (paired only); assigns each

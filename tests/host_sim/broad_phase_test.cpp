@@ -1,0 +1,306 @@
+// Stage 1 of the thin-body collision (host_sim/src/thin_body/broad_phase.cpp), tested through its
+// internal interface: the candidate faces must be exactly the faces the later stages need
+// (compared with a brute-force scan of every face, on random poses and through real plunges
+// where Bullet's node-tree leaves go stale), nothing out of contact, and for a fixed contact the
+// work done (tree nodes, seeds, faces tested) must not grow with the mesh.
+#include "thin_body/collision_state.hpp"
+
+#include <gtest/gtest.h>
+
+#include <BulletSoftBody/btSoftBody.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <iterator>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "soft_scene_fixture.hpp"
+
+namespace fissure::host {
+namespace {
+
+using test_scene::kStep_s;
+
+// CreateEllipsoid(res) gives 2·res + 2 faces: 63 → the paper's 128; 639 → 1280; 2559 → 5120; 10239 → 20480.
+int ellipsoid_resolution(int faces) { return (faces - 2) / 2; }
+
+// The collision's own frame construction (thin_body_collision.cpp make_frame), for the stages.
+thin_body::StepFrame make_frame(const thin_body::CollisionModel& model, std::int64_t step, const ToolPose& previous, const ToolPose& current) {
+  thin_body::StepFrame frame;
+  frame.step = step;
+  frame.dt_s = kStep_s;
+  frame.r_prev = previous.orientation_world.normalized().toRotationMatrix();
+  frame.t_prev = previous.position_world_m;
+  frame.r_cur = current.orientation_world.normalized().toRotationMatrix();
+  frame.t_cur = current.position_world_m;
+  frame.velocity_world_m_s = (current.position_world_m - previous.position_world_m) / kStep_s;
+  const Eigen::AngleAxisd rotation(frame.r_cur * frame.r_prev.transpose());
+  frame.angular_velocity_world = rotation.axis() * (rotation.angle() / kStep_s);
+  frame.swept_tool_world_m.setEmpty();
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d p = model.tool.bounds_tool_m().corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner));
+    frame.swept_tool_world_m.extend(frame.r_prev * p + frame.t_prev);
+    frame.swept_tool_world_m.extend(frame.r_cur * p + frame.t_cur);
+  }
+  return frame;
+}
+
+Eigen::Vector3d to_eigen(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
+
+// Brute force over EVERY face, against broad_phase.cpp's criterion. A face is NEEDED when its
+// tool-frame start/end bounds come within near_pad of the tool's bounds, or within memory_pad of
+// the tool nodes in contact last step, AND its world start/end bounds meet those padded regions
+// swept over the step (the tool-frame bounds alone over-cover: a face moving 6 cm past the tool
+// within one step has tool-frame bounds spanning the tool although its path does not). A face is
+// ALLOWED when the tool-frame condition holds. The broad phase must return every needed face and
+// only allowed ones.
+struct FaceSets {
+  std::set<int> needed, allowed;
+};
+
+Eigen::AlignedBox3d grown(Eigen::AlignedBox3d box, double by_m) {
+  box.min().array() -= by_m;
+  box.max().array() += by_m;
+  return box;
+}
+
+Eigen::AlignedBox3d swept_world(const thin_body::StepFrame& frame, const Eigen::AlignedBox3d& box_tool) {
+  Eigen::AlignedBox3d out;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d p = box_tool.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner));
+    out.extend(frame.r_prev * p + frame.t_prev);
+    out.extend(frame.r_cur * p + frame.t_cur);
+  }
+  return out;
+}
+
+FaceSets needed_faces(const thin_body::CollisionModel& model, const thin_body::StepFrame& frame, const btSoftBody& soft,
+                      const std::vector<int>& last_contact_nodes) {
+  const ThinBodyCollisionParams& p = model.params;
+  const Eigen::AlignedBox3d near = grown(model.tool.bounds_tool_m(), std::max(p.contact_distance_m, p.release_distance_m) + p.skin_m);
+  Eigen::AlignedBox3d memory;
+  for (const int n : last_contact_nodes) memory.extend(model.tool.positions_tool_m()[static_cast<std::size_t>(n)]);
+  if (!memory.isEmpty()) memory = grown(memory, model.memory_depth_m + p.contact_distance_m);
+  const Eigen::AlignedBox3d near_world = swept_world(frame, near);
+  const Eigen::AlignedBox3d memory_world = memory.isEmpty() ? memory : swept_world(frame, memory);
+  FaceSets out;
+  for (int f = 0; f < model.soft.face_count; ++f) {
+    Eigen::AlignedBox3d box_tool, box_world;
+    for (const int v : model.soft.face_nodes[static_cast<std::size_t>(f)]) {
+      box_tool.extend(frame.r_prev.transpose() * (to_eigen(soft.m_nodes[v].m_q) - frame.t_prev));
+      box_tool.extend(frame.r_cur.transpose() * (to_eigen(soft.m_nodes[v].m_x) - frame.t_cur));
+      box_world.extend(to_eigen(soft.m_nodes[v].m_q));
+      box_world.extend(to_eigen(soft.m_nodes[v].m_x));
+    }
+    const bool near_tool = box_tool.intersects(near);
+    const bool memory_tool = !memory.isEmpty() && box_tool.intersects(memory);
+    if (near_tool || memory_tool) out.allowed.insert(f);
+    if ((near_tool && box_world.intersects(near_world)) || (memory_tool && box_world.intersects(memory_world))) out.needed.insert(f);
+  }
+  return out;
+}
+
+void expect_between(const std::set<int>& got, const FaceSets& sets, const std::string& where) {
+  std::vector<int> missing, extra;
+  std::set_difference(sets.needed.begin(), sets.needed.end(), got.begin(), got.end(), std::back_inserter(missing));
+  std::set_difference(got.begin(), got.end(), sets.allowed.begin(), sets.allowed.end(), std::back_inserter(extra));
+  EXPECT_TRUE(missing.empty()) << where << ": " << missing.size() << " needed faces missing, first " << (missing.empty() ? -1 : missing[0]);
+  EXPECT_TRUE(extra.empty()) << where << ": " << extra.size() << " candidates not allowed, first " << (extra.empty() ? -1 : extra[0]);
+}
+
+struct Harness {
+  test_scene::SoftWorld world{true};
+  ToolNodes tool;
+  ThinBodyCollisionParams params;
+  thin_body::CollisionModel model;
+  thin_body::CollisionData data;
+
+  Harness(int faces, const ToolNodes& t)
+      : tool(t), model(thin_body::build_collision_model(tool, settled_sphere(world, faces).soft(), params, true)) {
+    thin_body::allocate_collision_data(model, data);
+  }
+
+  static test_scene::SoftWorld& settled_sphere(test_scene::SoftWorld& w, int faces) {
+    w.add_sphere(test_scene::kSphereRadius_m, ellipsoid_resolution(faces));
+    for (int i = 0; i < 20; ++i) w.step_dynamics();
+    return w;
+  }
+
+  // The pipeline of ThinBodyCollisionImpl::step, stage by stage, so the test can see the broad
+  // phase's data. Returns the frame used.
+  thin_body::StepFrame step(const ToolPose& previous, const ToolPose& current, bool respond) {
+    ++data.step;
+    const thin_body::StepFrame frame = make_frame(model, data.step, previous, current);
+    const bool hit = thin_body::broad_phase(model, frame, world.soft(), data);
+    if (!hit) {
+      std::fill(data.node_face.begin(), data.node_face.end(), -1);
+      std::fill(data.node_age.begin(), data.node_age.end(), 0);
+      return frame;
+    }
+    if (respond) {
+      thin_body::sweep_tool_nodes(model, data);
+      (void)thin_body::exclude_infeasible_pairs(model, data);
+      (void)thin_body::enforce_displacement(model, frame, world.soft(), data);
+      CollisionStepResult out;
+      out.reserve_for(model.soft.face_count);
+      thin_body::hunt_crossley_force(model, frame, world.soft(), data, out);
+    }
+    return frame;
+  }
+
+  std::vector<int> last_contact_nodes() const {
+    std::vector<int> out;
+    for (const int n : data.contact_nodes)
+      if (data.node_face[static_cast<std::size_t>(n)] >= 0) out.push_back(n);
+    return out;
+  }
+
+  std::set<int> candidate_faces() const { return {data.candidate_faces.begin(), data.candidate_faces.end()}; }
+};
+
+void expect_candidate_nodes_are_the_vertices(Harness& h, const thin_body::StepFrame& frame) {
+  std::set<int> vertices;
+  for (const int f : h.data.candidate_faces)
+    for (const int v : h.model.soft.face_nodes[static_cast<std::size_t>(f)]) vertices.insert(v);
+  const std::set<int> nodes(h.data.candidate_nodes.begin(), h.data.candidate_nodes.end());
+  EXPECT_EQ(nodes.size(), h.data.candidate_nodes.size()) << "a candidate node listed twice";
+  EXPECT_EQ(nodes, vertices);
+  for (const int v : h.data.candidate_nodes) {
+    const auto i = static_cast<std::size_t>(v);
+    const Eigen::Vector3d start = frame.r_prev.transpose() * (to_eigen(h.world.soft().m_nodes[v].m_q) - frame.t_prev);
+    EXPECT_LT((h.data.start_tool_m[i] - start).norm(), 1e-9);
+  }
+}
+
+// Random tool poses around and through the sphere (random orientation, a random move of up to
+// 6 cm and up to 0.2 rad per step): every needed face, only allowed ones (brute force).
+TEST(BroadPhase, RandomPosesGiveEveryNeededFaceAndNoOther) {
+  std::mt19937 rng(5150);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  int poses_with_candidates = 0;
+  for (const int faces : {128, 1280}) {
+    Harness h(faces, test_scene::plate_tool(0.004));
+    const Eigen::Vector3d centre(0, test_scene::kSphereRadius_m, 0);
+    for (int trial = 0; trial < 150; ++trial) {
+      h.world.step_dynamics();  // start (m_q) and end (m_x) positions differ
+      ToolPose previous;
+      previous.orientation_world = Eigen::Quaterniond::UnitRandom();
+      previous.position_world_m = centre + 0.07 * Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
+      ToolPose current = previous;
+      current.position_world_m += 0.06 * Eigen::Vector3d(unit(rng), unit(rng), unit(rng)) * std::abs(unit(rng));
+      current.orientation_world =
+          (Eigen::Quaterniond(Eigen::AngleAxisd(0.2 * unit(rng), Eigen::Vector3d(unit(rng), unit(rng), unit(rng)).normalized())) *
+           previous.orientation_world).normalized();
+      // Some tool nodes "in contact last step" (the side-memory region of the query).
+      h.data.contact_nodes.clear();
+      std::fill(h.data.node_face.begin(), h.data.node_face.end(), -1);
+      if (trial % 2 == 0) {
+        const int first = static_cast<int>(std::abs(unit(rng)) * (h.tool.node_count() - 5));
+        for (int n = first; n < first + 5; ++n) {
+          h.data.contact_nodes.push_back(n);
+          h.data.node_face[static_cast<std::size_t>(n)] = 0;
+        }
+      }
+      const std::vector<int> memory = h.last_contact_nodes();
+      // needed_faces() must see the body as broad_phase() does: compute it on the same frame.
+      const thin_body::StepFrame frame = make_frame(h.model, h.data.step + 1, previous, current);
+      const FaceSets expected = needed_faces(h.model, frame, h.world.soft(), memory);
+      const thin_body::StepFrame used = h.step(previous, current, false);
+      ASSERT_EQ(used.step, frame.step);
+      expect_between(h.candidate_faces(), expected, std::to_string(faces) + " faces, trial " + std::to_string(trial));
+      expect_candidate_nodes_are_the_vertices(h, used);
+      poses_with_candidates += expected.needed.empty() ? 0 : 1;
+    }
+  }
+  EXPECT_GT(poses_with_candidates, 60) << "the random poses must mostly reach the sphere";
+}
+
+// Through real plunges (the collision moving nodes, Bullet predicting them elsewhere, the tool
+// stopping dead at the bottom) and holds, at 0.1–50 m/s: never a needed face missing, never a
+// candidate that is not allowed.
+TEST(BroadPhase, PlungesAndHoldsGiveEveryNeededFaceAndNoOther) {
+  for (const double speed : {0.1, 2.0, 20.0, 50.0}) {
+    Harness h(1280, test_scene::plate_tool(0.002));
+    ToolPose previous;
+    previous.position_world_m = Eigen::Vector3d(0.003, 0.115, -0.002);
+    int contact_steps = 0;
+    const int plunge_steps = static_cast<int>(std::ceil(0.045 / (speed * kStep_s)));
+    for (int s = 0; s < plunge_steps + 150; ++s) {
+      ToolPose current = previous;
+      current.position_world_m.y() = std::max(0.07, previous.position_world_m.y() - speed * kStep_s);
+      h.world.step_dynamics();
+      const std::vector<int> memory = h.last_contact_nodes();
+      const thin_body::StepFrame frame = make_frame(h.model, h.data.step + 1, previous, current);
+      const FaceSets expected = needed_faces(h.model, frame, h.world.soft(), memory);
+      (void)h.step(previous, current, true);
+      expect_between(h.candidate_faces(), expected, "speed " + std::to_string(speed) + " step " + std::to_string(s));
+      if (HasFailure()) return;
+      contact_steps += h.data.contact_nodes.empty() ? 0 : 1;
+      previous = current;
+    }
+    EXPECT_GT(contact_steps, 100) << "speed " << speed;
+  }
+}
+
+TEST(BroadPhase, OutOfContactOnlyTheRootIsTested) {
+  Harness h(5120, test_scene::plate_tool(0.004));
+  ToolPose previous;
+  previous.position_world_m = Eigen::Vector3d(0, 0.2, 0);
+  ToolPose current = previous;
+  current.position_world_m.y() = 0.17;  // moving, 6 cm above the sphere
+  (void)h.step(previous, current, true);  // first call: fits the leaves once
+  h.world.step_dynamics();
+  (void)h.step(current, current, true);
+  EXPECT_TRUE(h.data.candidate_faces.empty());
+  EXPECT_EQ(h.data.broad_tree_nodes_visited, 1);
+  EXPECT_EQ(h.data.broad_seed_nodes, 0);
+  EXPECT_EQ(h.data.broad_faces_tested, 0);
+}
+
+// The work for a fixed contact: a plate held on the sphere's top at the depth where about 24
+// triangles are candidates. Tree nodes visited, seeds and faces tested per candidate face must
+// not grow with the mesh (16× more faces from 1280 to 20480).
+TEST(BroadPhase, WorkForAFixedContactDoesNotGrowWithTheMesh) {
+  struct Work {
+    int faces, candidates, tree, seeds, tested;
+  };
+  std::vector<Work> rows;
+  for (const int faces : {1280, 5120, 20480}) {
+    Harness h(faces, test_scene::plate_tool(0.002));
+    h.world.step_without_dynamics();
+    double top = -1.0;
+    for (int i = 0; i < h.world.soft().m_nodes.size(); ++i) top = std::max(top, static_cast<double>(h.world.soft().m_nodes[i].m_x.y()));
+    // Lower the plate (quasi-statically, no response: the sphere stays as it is) until ~24 faces.
+    double depth = 0.0;
+    for (; depth < 0.01; depth += 2e-5) {
+      ToolPose pose;
+      pose.position_world_m = Eigen::Vector3d(0, top + 0.001 - depth, 0);
+      (void)h.step(pose, pose, false);
+      if (h.data.candidate_faces.size() >= 24) break;
+    }
+    ToolPose pose;
+    pose.position_world_m = Eigen::Vector3d(0, top + 0.001 - depth, 0);
+    h.data.broad_previous_candidates.clear();  // measure one step's own work, not the re-test of the last
+    (void)h.step(pose, pose, false);
+    rows.push_back({faces, static_cast<int>(h.data.candidate_faces.size()), h.data.broad_tree_nodes_visited, h.data.broad_seed_nodes,
+                    h.data.broad_faces_tested});
+    std::printf("faces %6d: candidate faces %4d, tree nodes visited %5d, seed nodes %5d, faces tested %5d\n", faces, rows.back().candidates,
+                rows.back().tree, rows.back().seeds, rows.back().tested);
+  }
+  for (const Work& w : rows) {
+    EXPECT_GE(w.candidates, 24);
+    EXPECT_LE(w.candidates, 60);
+  }
+  const auto per_candidate = [](const Work& w, int count) { return static_cast<double>(count) / w.candidates; };
+  const Work& coarse = rows.front();
+  const Work& fine = rows.back();
+  EXPECT_LE(per_candidate(fine, fine.tested), 4.0 * per_candidate(coarse, coarse.tested));
+  EXPECT_LE(per_candidate(fine, fine.seeds), 4.0 * per_candidate(coarse, coarse.seeds));
+  EXPECT_LE(per_candidate(fine, fine.tree), 4.0 * per_candidate(coarse, coarse.tree));
+}
+
+}  // namespace
+}  // namespace fissure::host
