@@ -20,6 +20,8 @@
 #include "hil_latency.hpp"
 #include "bench_proxy.hpp"
 #include "stress_command.hpp"
+#include "bench_all.hpp"
+#include "bench_pareto.hpp"
 
 namespace {
 
@@ -71,6 +73,8 @@ int main(int argc, char** argv) {
   fissure::app::register_render(tree);
   fissure::app::register_bench_view(tree);
   fissure::app::register_stress(tree);
+  fissure::app::register_bench_all(tree);
+  fissure::app::register_bench_pareto(tree);
 
   if (const std::string unknown = unknown_subcommand(root, argc, argv); !unknown.empty()) {
     std::fprintf(stderr, "fissure: error: %s (see 'fissure --help')\n", unknown.c_str());

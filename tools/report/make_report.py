@@ -292,15 +292,21 @@ def section_pareto(report, data, problems, targets):
         else:
             report.add(f"Sub-steps per {fmt(pareto.get('host_step_s', 0) * 1e3)} ms host step at the scene's node spacing "
                        f"({fmt(pareto.get('scene_node_spacing_m', 0) * 1e3)} mm); the most sub-steps is the reference.")
+        others = [r for r in rows if not r.get("reference")]
+        if others and all(r["rms_error_pct"] == 0.0 and r["peak_error_pct"] == 0.0 for r in others):
+            report.add(f"**Every {knob_label} setting gives a force identical to the reference's at every step** (RMS and peak "
+                       "error exactly 0): in this scene the knob changes only the cost.")
         report.add(f"Same scripted trajectory ({fmt(pareto.get('trajectory_s'))} s after {fmt(pareto.get('settle_s'))} s settling) "
                    f"for every row, {pareto.get('repeats', '?')} repeat(s) per row.")
         report.add("")
         report.add(table([knob_label, "tool nodes", "step median µs", "step p99 µs", "in-contact median µs", "RMS error %",
-                          "peak error %", "crossed nodes", "max penetration mm", "deterministic"],
+                          "peak error %", "crossed nodes", "max penetration mm", "hold |F| start N", "hold drift %",
+                          "deterministic"],
                          [[unit_fn(r[knob]) + (" (ref)" if r.get("reference") else ""), fmt(r.get("tool_nodes")),
                            fmt(r["host_step_us"]["median"]), fmt(r["host_step_us"]["p99"]),
                            fmt(r["host_step_in_contact_us"]["median"]), fmt(r["rms_error_pct"]), fmt(r["peak_error_pct"]),
-                           fmt(r["crossed_nodes_max"]), fmt(r["max_penetration_m"] * 1e3), fmt(r.get("deterministic"))]
+                           fmt(r["crossed_nodes_max"]), fmt(r["max_penetration_m"] * 1e3), fmt(r.get("hold_force_start_n")),
+                           fmt(r.get("hold_drift_pct")), fmt(r.get("deterministic"))]
                           for r in rows]))
         report.add(targets_table([t for t in targets if t.section == "pareto " + key]))
     # (d) FK tolerance
@@ -453,14 +459,18 @@ def section_scaling(report, data, problems, targets):
         missing(report, "collision", problems)
         return
     rows = col["scaling"]
+
+    def case_of(r):
+        return r.get("case", "same_press" if r["in_contact"] else "out")
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
-    for method, in_contact, field, label, marker in [
-            ("paired", True, "step_median_us", "paired: whole step, in contact", "o"),
-            ("paired", True, "collision_median_us", "paired: collision only, in contact", "s"),
-            ("paired", False, "collision_median_us", "paired: collision only, out of contact", "v"),
-            ("bullet", True, "step_median_us", "bullet: whole step, in contact", "x"),
-            ("bullet", True, "collision_median_us", "bullet: collision only, in contact", "+")]:
-        pts = sorted((r["faces"], r[field]) for r in rows if r["method"] == method and r["in_contact"] == in_contact)
+    for method, case, field, label, marker in [
+            ("paired", "same_press", "step_median_us", "paired: whole step, same press", "o"),
+            ("paired", "same_press", "collision_median_us", "paired: collision only, same press", "s"),
+            ("paired", "same_contact", "collision_median_us", "paired: collision only, same contact", "D"),
+            ("paired", "out", "collision_median_us", "paired: collision only, out of contact", "v"),
+            ("bullet", "same_press", "step_median_us", "bullet: whole step, same press", "x"),
+            ("bullet", "same_press", "collision_median_us", "bullet: collision only, same press", "+")]:
+        pts = sorted((r["faces"], r[field]) for r in rows if r["method"] == method and case_of(r) == case)
         if pts:
             ax.plot([p[0] for p in pts], [max(p[1], 1e-3) for p in pts], marker=marker, label=label)
     ax.set_xscale("log")
@@ -469,13 +479,17 @@ def section_scaling(report, data, problems, targets):
     ax.set_ylabel("median time per host step [µs]")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize="small")
-    ax.set_title("host step cost against mesh size (plate 4 mm into the sphere)", fontsize=9)
+    ax.set_title("host step cost against mesh size (plate pressed into the sphere)", fontsize=9)
     report.figure(fig, "cost_vs_mesh.png", "cost against mesh size")
-    report.add("128 faces is the paper's sphere (Bullet's ellipsoid); larger meshes are icospheres.")
+    report.add("128 faces is the paper's sphere (Bullet's ellipsoid); larger meshes are icospheres. `out` = 2 cm above the "
+               "sphere; `same_press` = the same depth on every mesh (the contact set grows with the mesh); `same_contact` = "
+               "the first depth with the same number of contacted triangles on every mesh.")
     report.add("")
-    report.add(table(["method", "faces", "contact", "contacts", "step median µs", "step p99 µs", "collision median µs"],
-                     [[r["method"], r["faces"], "in" if r["in_contact"] else "out", fmt(r.get("contacts")),
-                       fmt(r["step_median_us"]), fmt(r.get("step_p99_us")), fmt(r["collision_median_us"])] for r in rows]))
+    report.add(table(["method", "faces", "case", "depth mm", "contacted triangles", "step median µs", "step p99 µs",
+                      "collision median µs", "collision µs per triangle"],
+                     [[r["method"], r["faces"], case_of(r), fmt(r["depth_m"] * 1e3) if "depth_m" in r else "—",
+                       fmt(r.get("contacted_triangles", r.get("contacts"))), fmt(r["step_median_us"]), fmt(r.get("step_p99_us")),
+                       fmt(r["collision_median_us"]), fmt(r.get("collision_us_per_contacted_triangle"))] for r in rows]))
     report.add(targets_table([t for t in targets if t.section == "collision scaling"]))
 
 

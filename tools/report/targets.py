@@ -140,7 +140,7 @@ def collision_targets(col):
     ind_d = ["slab exponent within ±0.02 of the configured n", "sphere exponent beside the rigid-cap prediction n+1",
              "force at fixed depth within 2 % between the two finest meshes"]
     scale_d = ["paired step ≤ 1.5 × bullet's on the 128-face scene (in contact)",
-               "out-of-contact collision cost ≤ 5 % of in-contact", "collision cost ≤ 2 × from the smallest to the largest mesh"]
+               "out-of-contact collision cost ≤ 5 % of in-contact", "collision cost ≤ 2 × from the smallest to the largest mesh at the same contact"]
     if col is None:
         return (_absent("collision sweep", sweep_d, COL_SOURCE, "no collision.json")
                 + _absent("collision indentation", ind_d, COL_SOURCE, "no collision.json")
@@ -195,13 +195,18 @@ def collision_targets(col):
 
     scaling = col.get("scaling") or []
 
-    def row(method, faces, in_contact):
+    def case_of(r):
+        # Rows carry "case" (out / same_press / same_contact) since bench collision measures the same
+        # press and the same contact separately; older JSON has only in_contact.
+        return r.get("case", "same_press" if r["in_contact"] else "out")
+
+    def row(method, faces, case):
         for r in scaling:
-            if r["method"] == method and r["faces"] == faces and r["in_contact"] == in_contact:
+            if r["method"] == method and r["faces"] == faces and case_of(r) == case:
                 return r
         return None
-    paired_in = row("paired", 128, True)
-    bullet_in = row("bullet", 128, True)
+    paired_in = row("paired", 128, "same_press")
+    bullet_in = row("bullet", 128, "same_press")
     if paired_in and bullet_in:
         ratio = paired_in["step_median_us"] / bullet_in["step_median_us"]
         out.append(Target("collision scaling", scale_d[0],
@@ -209,25 +214,30 @@ def collision_targets(col):
                           _status(ratio <= 1.5), COL_SOURCE))
     else:
         out.append(Target("collision scaling", scale_d[0], "no 128-face rows", NOT_CHECKED, COL_SOURCE))
+    # In contact = the same contact where measured (the patch the issue compares), else the press.
+    in_case = "same_contact" if any(case_of(r) == "same_contact" for r in scaling) else "same_press"
     fractions = []
     for r in scaling:
-        if r["method"] == "paired" and not r["in_contact"]:
-            partner = row("paired", r["faces"], True)
+        if r["method"] == "paired" and case_of(r) == "out":
+            partner = row("paired", r["faces"], in_case)
             if partner and partner["collision_median_us"] > 0:
                 fractions.append((r["collision_median_us"] / partner["collision_median_us"], r["faces"]))
     if fractions:
         worst, faces = max(fractions)
-        out.append(Target("collision scaling", scale_d[1], f"worst {100 * worst:.1f} % (at {faces} faces)", _status(worst <= 0.05),
-                          COL_SOURCE))
+        out.append(Target("collision scaling", scale_d[1], f"worst {100 * worst:.1f} % (at {faces} faces, vs {in_case})",
+                          _status(worst <= 0.05), COL_SOURCE))
     else:
         out.append(Target("collision scaling", scale_d[1], "no paired out/in pairs", NOT_CHECKED, COL_SOURCE))
-    paired_contact = sorted((r for r in scaling if r["method"] == "paired" and r["in_contact"]), key=lambda r: r["faces"])
+    paired_contact = sorted((r for r in scaling if r["method"] == "paired" and case_of(r) == in_case), key=lambda r: r["faces"])
     if len(paired_contact) >= 2:
         small, large = paired_contact[0], paired_contact[-1]
         growth = large["collision_median_us"] / small["collision_median_us"]
-        out.append(Target("collision scaling", scale_d[2],
-                          f"{_f(small['collision_median_us'])} µs at {small['faces']} → {_f(large['collision_median_us'])} µs at "
-                          f"{large['faces']} faces: {growth:.1f}×", _status(growth <= 2.0), COL_SOURCE))
+        text = (f"{_f(small['collision_median_us'])} µs at {small['faces']} → {_f(large['collision_median_us'])} µs at "
+                f"{large['faces']} faces ({in_case.replace('_', ' ')}): {growth:.2f}×")
+        per_tri = (col.get("scaling_summary") or {}).get("same_press_per_triangle_ratio_fine_over_coarse")
+        if per_tri is not None:
+            text += f"; per contacted triangle at the same press {per_tri:.2f}×"
+        out.append(Target("collision scaling", scale_d[2], text, _status(growth <= 2.0), COL_SOURCE))
     else:
         out.append(Target("collision scaling", scale_d[2], "fewer than two paired meshes", NOT_CHECKED, COL_SOURCE))
     return out
