@@ -5,9 +5,13 @@
 // What the later stages need, and so what this stage must return (all in the TOOL frame, where the
 // node sweep and the response work — start = Bullet's m_q seen from the previous tool pose, end =
 // m_x seen from the current pose):
-//   * every soft face whose start/end bounds come within `near_pad` of the tool's bounds — a tool
-//     node within contact_distance of it (node sweep), a vertex whose relative path enters the
-//     tool (guard) or a vertex held within release_distance of a tool face (hysteresis);
+//   * every soft face whose start/end bounds come within `near_pad` (contact_distance + skin) of
+//     the tool's bounds — a tool node within contact_distance of it (node sweep), a vertex whose
+//     relative path enters the tool (guard);
+//   * every face around a soft node held on the tool LAST step that is still within
+//     release_distance of the tool's bounds (the response's hysteresis keeps such a node
+//     colliding). Only those nodes get the release band: a plate held on a sphere does not
+//     collect every face within release_distance under its whole face;
 //   * every soft face within `memory_pad` (memory_depth + contact) of the tool nodes that were in
 //     contact LAST step: only those may keep a contact while starting behind their triangle
 //     (node_sweep.cpp's side memory). Bounding those nodes, not the whole tool, keeps a held
@@ -66,6 +70,7 @@ Eigen::AlignedBox3d swept_world(const StepFrame& frame, const Eigen::AlignedBox3
 // The queries of one step (see the header comment).
 struct Query {
   Eigen::AlignedBox3d near_tool;      // tool frame: tool bounds + near_pad
+  Eigen::AlignedBox3d release_tool;   // tool frame: tool bounds + release pad (nodes held last step)
   Eigen::AlignedBox3d memory_tool;    // tool frame: last step's contact nodes + memory_pad (may be empty)
   Eigen::AlignedBox3d near_world;     // world: seeds of near_tool faces (+ reach)
   Eigen::AlignedBox3d memory_world;   // world: seeds of memory_tool faces (+ reach; may be empty)
@@ -92,10 +97,8 @@ struct Query {
 constexpr double kStretchAllowance = 2.0;
 double seed_reach_m(const CollisionModel& model) { return kStretchAllowance * model.soft.max_rest_edge_m / std::sqrt(3.0); }
 
-double near_pad_m(const CollisionModel& model) {
-  const ThinBodyCollisionParams& p = model.params;
-  return std::max(p.contact_distance_m, p.release_distance_m) + p.skin_m;
-}
+double near_pad_m(const CollisionModel& model) { return model.params.contact_distance_m + model.params.skin_m; }
+double release_pad_m(const CollisionModel& model) { return std::max(model.params.contact_distance_m, model.params.release_distance_m) + model.params.skin_m; }
 double memory_pad_m(const CollisionModel& model) { return model.memory_depth_m + model.params.contact_distance_m; }
 
 // Tool-frame straight lines are not straight in the world when the tool turns within the step: a
@@ -115,6 +118,7 @@ Query make_query(const CollisionModel& model, const StepFrame& frame, const Coll
   Query q;
   const auto& positions = model.tool.positions_tool_m();
   q.near_tool = grown(model.tool.bounds_tool_m(), near_pad);
+  q.release_tool = grown(model.tool.bounds_tool_m(), release_pad_m(model));
   for (const int node : data.contact_nodes)
     if (data.node_face[static_cast<std::size_t>(node)] >= 0) q.memory_tool.extend(positions[static_cast<std::size_t>(node)]);
   if (!q.memory_tool.isEmpty()) q.memory_tool = grown(q.memory_tool, memory_pad);
@@ -181,6 +185,15 @@ class Collector {
     data_.end_tool_m[i] = frame_.r_cur.transpose() * (to_eigen(n.m_x) - frame_.t_cur);
   }
 
+  // A vertex held on a tool face last step and still within the release pad of the tool.
+  bool has_held_vertex_in_reach(std::size_t face) const {
+    for (const int vertex : model_.soft.face_nodes[face]) {
+      const auto v = static_cast<std::size_t>(vertex);
+      if (data_.hold_stamp[v] == frame_.step - 1 && query_.release_tool.contains(data_.end_tool_m[v])) return true;
+    }
+    return false;
+  }
+
   void test_face(int face) {
     const auto f = static_cast<std::size_t>(face);
     if (data_.face_candidate_stamp[f] == frame_.step) return;
@@ -192,7 +205,7 @@ class Collector {
       box_tool.extend(data_.start_tool_m[static_cast<std::size_t>(vertex)]);
       box_tool.extend(data_.end_tool_m[static_cast<std::size_t>(vertex)]);
     }
-    if (!query_.face_needed(box_tool)) return;
+    if (!query_.face_needed(box_tool) && !has_held_vertex_in_reach(f)) return;
     data_.candidate_faces.push_back(face);
     for (const int vertex : model_.soft.face_nodes[f]) {
       const auto v = static_cast<std::size_t>(vertex);
@@ -247,19 +260,26 @@ bool broad_phase(const CollisionModel& model, const StepFrame& frame, btSoftBody
   if (root != nullptr) {
     data.broad_tree_nodes_visited = 1;
     if (query.leaf_may_hold_seed(root->volume)) {
+      // The walk runs right after Bullet's own step over the whole body, so the tree is cold in
+      // the cache: both children are prefetched before either is tested (their misses overlap),
+      // and a leaf's soft node as soon as the leaf is known to be near.
       data.tree_stack.clear();
       data.tree_stack.push_back(root);
       while (!data.tree_stack.empty()) {
         const btDbvtNode* node = data.tree_stack.back();
         data.tree_stack.pop_back();
-        if (node != root) ++data.broad_tree_nodes_visited;
-        if (!query.leaf_may_hold_seed(node->volume)) continue;
-        if (node->isinternal()) {
-          data.tree_stack.push_back(node->childs[0]);
-          data.tree_stack.push_back(node->childs[1]);
-        } else {
+        if (node->isleaf()) {
           const auto* soft_node = static_cast<const btSoftBody::Node*>(node->data);
           collect.seed_if_near(static_cast<int>(soft_node - &soft.m_nodes[0]));
+          continue;
+        }
+        __builtin_prefetch(node->childs[0]);
+        __builtin_prefetch(node->childs[1]);
+        for (const btDbvtNode* child : node->childs) {
+          ++data.broad_tree_nodes_visited;
+          if (!query.leaf_may_hold_seed(child->volume)) continue;
+          if (child->isleaf()) __builtin_prefetch(&static_cast<const btSoftBody::Node*>(child->data)->m_x);
+          data.tree_stack.push_back(child);
         }
       }
     }
