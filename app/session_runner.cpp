@@ -185,9 +185,22 @@ SessionOutcome run_session(const SessionOptions& options) {
 
   const double expected_s = until_interrupted ? 60.0 : duration_s + 1.0;
   // The view's picture model is built from the settled body (its rest shape is what the
-  // deformation colours are measured from); the sinks start before the first tick.
-  std::unique_ptr<viewer::SessionView> view;
+  // deformation colours are measured from), here, before any thread steps the simulation, and
+  // its sinks (window, frame writer) start before the first tick. (Started after the rt
+  // thread's mlockall instead, Mesa mapping and locking LLVM cost the running rt loop a 30 ms
+  // gap and 71 overruns on this VM; started before, the cost is a longer rt set-up, measured in
+  // summary.json's rt_setup.seconds, and the session's length counts from the first tick.)
+  std::optional<viewer::RenderModel> view_model;
   if (options.view || !options.frames_dir.empty()) {
+    try {
+      view_model = viewer::make_render_model(host.simulation());
+    } catch (const std::exception& e) {
+      throw CommandError(std::string("--view/--frames: ") + e.what());
+    }
+  }
+  std::unique_ptr<viewer::SessionView> view;
+  std::string view_error;
+  const auto start_view = [&] {
     viewer::SessionViewOptions vo;
     vo.window = options.view;
     vo.window_options.width_px = options.frame_width_px;
@@ -200,14 +213,14 @@ SessionOutcome run_session(const SessionOptions& options) {
     vo.frame_height_px = options.frame_height_px;
     vo.wait_for_frames = options.lockstep;
     vo.expected_host_steps = static_cast<std::size_t>(expected_s / host_dt_s);
-    std::string error, notice;
-    try {
-      view = viewer::SessionView::start(viewer::make_render_model(host.simulation()), vo, error, notice);
-    } catch (const std::exception& e) {
-      throw CommandError(std::string("--view/--frames: ") + e.what());
-    }
-    if (!view) throw CommandError("--frames: " + error);
+    std::string notice;
+    view = viewer::SessionView::start(*view_model, vo, view_error, notice);
+    if (!view) view_error = "--frames: " + view_error;
     if (!notice.empty()) std::fprintf(stderr, "%s\n", notice.c_str());
+  };
+  if (view_model) {
+    start_view();
+    if (!view) throw CommandError(view_error);
   }
   RtFiguresTracker rt_figures;
   SessionRecorder recorder(options.out_dir, static_cast<std::size_t>(expected_s * options.rt_rate_hz),
@@ -221,6 +234,7 @@ SessionOutcome run_session(const SessionOptions& options) {
   std::uint64_t host_late_steps = 0;
   std::uint64_t host_status_dropped = 0;
   double wakeup_median_us = 0.0;
+  double rt_setup_s = 0.0;
   double wakeup_p99_us = 0.0;
   double wakeup_max_us = 0.0;
   double max_tick_us = 0.0;
@@ -286,8 +300,11 @@ SessionOutcome run_session(const SessionOptions& options) {
       rt::RtThreadSetup setup;
       rt::RtThreadConfig thread_config;
       thread_config.policy = rt::RtPolicy::kBestEffort;
+      const auto setup_start = WallClock::now();
       setup_report = setup.apply(thread_config);
-      loop.run_until(end_ns, stop_rt);
+      rt_setup_s = std::chrono::duration<double>(WallClock::now() - setup_start).count();
+      // The session's length counts from the first tick, not from before the set-up.
+      loop.run_until(until_interrupted ? end_ns : clock.now() + (end_ns - start_ns), stop_rt);
       rt_done.store(true, std::memory_order_release);
     });
     std::thread host_thread([&] {
@@ -346,6 +363,7 @@ SessionOutcome run_session(const SessionOptions& options) {
     max_tick_us = static_cast<double>(loop.stats().max_tick_ns) * 1e-3;
     extra["rt_setup"] = {{"sched_fifo", setup_report.sched_fifo},
                          {"memory_locked", setup_report.memory_locked},
+                         {"seconds", rt_setup_s},
                          {"warnings", std::string(setup_report.message)}};
     if (setup_report.message[0] != '\0') spdlog::warn("rt thread: {}", setup_report.message);
     if (!host_error.empty()) extra["host_error"] = host_error;
