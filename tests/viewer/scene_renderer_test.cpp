@@ -41,6 +41,11 @@ bool is_tool(const std::uint8_t* px) {
   const int r = channel(px, 0), g = channel(px, 1), b = channel(px, 2);
   return r > 60 && g * 100 > r * 52 && g * 100 < r * 85 && b * 100 < r * 35;
 }
+// The force arrow (magenta: red and blue high, green low).
+bool is_arrow(const std::uint8_t* px) {
+  const int r = channel(px, 0), g = channel(px, 1), b = channel(px, 2);
+  return r > 80 && b > 80 && g * 100 < r * 50 && g * 100 < b * 50;
+}
 
 // Fraction of pixels satisfying `pred` within the ring r_in ≤ |p − c| < r_out.
 template <typename Pred>
@@ -146,8 +151,13 @@ double visible_tool_fraction_after_plunge(SceneRendererTest& test, host::SceneCo
   const RgbaImage image = test.render_to_png(model, *snapshot, camera, png);
   const auto tool_centre = camera.project(pose.position_world_m.cast<float>(), kWidthPx, kHeightPx);
   EXPECT_TRUE(tool_centre);
-  // Half the spatula's width (15 mm) seen from 0.25 m: sample well inside its outline.
-  return fraction_in_ring(image, tool_centre->head<2>(), 0.0F, 12.0F, is_tool);
+  // Half the spatula's width (15 mm) seen from 0.25 m: sample well inside its outline. The
+  // force arrow starts at the tool's centre and is drawn over it when the tool is on top: those
+  // pixels say nothing about the tool either way, so they are left out of the fraction.
+  const Eigen::Vector2f c = tool_centre->head<2>();
+  const double arrow = fraction_in_ring(image, c, 0.0F, 12.0F, is_arrow);
+  const double tool = fraction_in_ring(image, c, 0.0F, 12.0F, is_tool);
+  return arrow < 0.5 ? tool / (1.0 - arrow) : 0.0;
 }
 
 TEST_F(SceneRendererTest, PairedKeepsTheToolOnTopAfterAFastPlunge) {
