@@ -383,6 +383,10 @@ void read_tool(const std::string& file, TableReader& t, ToolDescription& tool, c
 
 void read_hunt_crossley(TableReader& t, HuntCrossleyDescription& hc) {
   hc.mode = t.choice<HuntCrossleyMode>("mode", {{"per_unit_area", HuntCrossleyMode::kPerUnitArea}, {"per_triangle", HuntCrossleyMode::kPerTriangle}});
+  hc.deformation_measure = t.choice<DeformationMeasureKind>(
+      "deformation_measure",
+      {{"normal_displacement", DeformationMeasureKind::kNormalDisplacement}, {"centroid_distance", DeformationMeasureKind::kCentroidDistance}},
+      DeformationMeasureKind::kNormalDisplacement);
   hc.exponent_n = t.in_range("exponent", "n", 0.5, 3.0);
   if (hc.mode == HuntCrossleyMode::kPerUnitArea) {
     hc.stiffness_k = t.in_range("stiffness", "pa_per_m_pow_n", 0.0, 1e30);

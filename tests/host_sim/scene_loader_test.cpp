@@ -138,12 +138,27 @@ TEST(SceneLoader, OutOfRangeValueNamesField) {
 }
 
 TEST(SceneLoader, ShapeMatchingIsOptionalAndRangeChecked) {
-  const std::string good = read(kScenes / "spatula-sphere.toml");
+  const std::string shipped = read(kScenes / "spatula-sphere.toml");
+  EXPECT_EQ(load_scene_text(shipped, "good.toml", kScenes).soft_body.shape_matching_ratio, 0.05);
+  // Without the (optional) key: its line, comment and all, removed.
+  const std::size_t key = shipped.find("shape_matching_ratio");
+  ASSERT_NE(key, std::string::npos);
+  const std::size_t next_key = shipped.find("damping_ratio", key);
+  const std::string good = shipped.substr(0, key) + shipped.substr(next_key);
   EXPECT_EQ(load_scene_text(good, "good.toml", kScenes).soft_body.shape_matching_ratio, 0.0);
   const std::string with = replace(good, "damping_ratio = 0.02", "damping_ratio = 0.02\nshape_matching_ratio = 0.05");
   EXPECT_EQ(load_scene_text(with, "good.toml", kScenes).soft_body.shape_matching_ratio, 0.05);
   const std::string bad = replace(good, "damping_ratio = 0.02", "damping_ratio = 0.02\nshape_matching_ratio = 1.5");
   expect_error(load_error(bad), line_of(bad, "shape_matching_ratio"), "soft_body.shape_matching_ratio", "must be in");
+}
+
+TEST(SceneLoader, DeformationMeasureIsOptionalAndChecked) {
+  const std::string good = read(kScenes / "spatula-sphere.toml");
+  EXPECT_EQ(load_scene_text(good, "good.toml", kScenes).hunt_crossley.deformation_measure, DeformationMeasureKind::kNormalDisplacement);
+  const std::string paper = replace(good, "exponent_n = 1.5", "exponent_n = 1.5\ndeformation_measure = \"centroid_distance\"");
+  EXPECT_EQ(load_scene_text(paper, "good.toml", kScenes).hunt_crossley.deformation_measure, DeformationMeasureKind::kCentroidDistance);
+  const std::string bad = replace(good, "exponent_n = 1.5", "exponent_n = 1.5\ndeformation_measure = \"centroid\"");
+  expect_error(load_error(bad), line_of(bad, "deformation_measure"), "hunt_crossley.deformation_measure", "not one of");
 }
 
 TEST(SceneLoader, UnreadableMeshNamesMeshPath) {
@@ -197,7 +212,8 @@ TEST(SceneTrajectory, LegsAndHoldsAreSampledLinearly) {
   const SceneDescription clamp = load_scene(kScenes / "clamp-sphere.toml");
   EXPECT_NEAR(sample_trajectory(clamp, 0.0).jaw_gap_m, 0.12, 1e-12);
   EXPECT_NEAR(sample_trajectory(clamp, 1.0).jaw_gap_m, 0.10, 1e-9);   // 0.02 m/s for 1 s
-  EXPECT_NEAR(sample_trajectory(clamp, 2.2).jaw_gap_m, 0.08, 1e-12);  // closed and held
+  // closed to 0.093 after 0.027 m / 0.02 m/s = 1.35 s, held 0.5 s
+  EXPECT_NEAR(sample_trajectory(clamp, 1.6).jaw_gap_m, 0.093, 1e-12);
 }
 
 }  // namespace

@@ -49,6 +49,8 @@ ToolNodeBins build_bins(const ToolNodes& tool) {
 }  // namespace
 
 void take_rest_state(const btSoftBody& soft, SoftSurfaceModel& model) {
+  model.rest_node_world_m.resize(static_cast<std::size_t>(model.node_count));
+  for (int i = 0; i < model.node_count; ++i) model.rest_node_world_m[static_cast<std::size_t>(i)] = to_eigen(soft.m_nodes[i].m_x);
   model.rest_centroid_world_m.resize(static_cast<std::size_t>(model.face_count));
   model.rest_area_m2.resize(static_cast<std::size_t>(model.face_count));
   double volume6 = 0.0;
@@ -142,6 +144,7 @@ void allocate_collision_data(const CollisionModel& model, CollisionData& data) {
   data.moved_nodes.reserve(soft_nodes);
   data.hold_stamp.assign(soft_nodes, -1);
   data.hold_plane.assign(soft_nodes, -1);
+  data.node_share.assign(soft_nodes, 0.0);
   data.candidate_nodes.clear();
   data.candidate_nodes.reserve(soft_nodes);
   data.tree_stack.clear();
@@ -158,6 +161,9 @@ void allocate_collision_data(const CollisionModel& model, CollisionData& data) {
   data.hc_stamp.assign(soft_faces, -1);
   data.hc_x_prev_m.assign(soft_faces, 0.0);
   data.hc_rate_filtered_m_s.assign(soft_faces, 0.0);
+  data.hc_corner_stamp.assign(3 * soft_faces, -1);
+  data.hc_corner_x_prev_m.assign(3 * soft_faces, 0.0);
+  data.hc_corner_rate_filtered_m_s.assign(3 * soft_faces, 0.0);
 }
 
 }  // namespace fissure::host::thin_body

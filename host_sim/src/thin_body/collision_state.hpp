@@ -24,7 +24,8 @@ struct SoftSurfaceModel {
   std::vector<std::array<int, 3>> face_nodes;
   std::vector<int> faces_of_node_begin;  // CSR: faces around each node
   std::vector<int> faces_of_node;
-  std::vector<Eigen::Vector3d> rest_centroid_world_m;
+  std::vector<Eigen::Vector3d> rest_node_world_m;      // normal_displacement's rest positions
+  std::vector<Eigen::Vector3d> rest_centroid_world_m;  // centroid_distance's rest centroids
   std::vector<double> rest_area_m2;
   double outward_sign = 1.0;   // multiplies Bullet's winding normal to point out of the soft body
   double max_rest_edge_m = 0.0;
@@ -90,6 +91,8 @@ struct CollisionData {
   std::vector<int> moved_nodes;            // ... listed (their triangles have a colliding node)
   std::vector<std::int64_t> hold_stamp;    // soft-node side memory: held on a tool plane ...
   std::vector<int> hold_plane;             // ... this one, at step hold_stamp
+  std::vector<double> node_share;          // colliding node's share of its force (valid where moved_stamp == step):
+                                           // 1 on the face, ramping to 0 over release_distance in front of it
   std::vector<int> candidate_nodes;
   std::vector<const btDbvtNode*> tree_stack;
   // Soft faces.
@@ -103,6 +106,10 @@ struct CollisionData {
   std::vector<std::int64_t> hc_stamp;   // last step the face was in contact (filter state valid)
   std::vector<double> hc_x_prev_m;
   std::vector<double> hc_rate_filtered_m_s;
+  // normal_displacement: the ẋ filter per triangle corner (index 3·face + corner).
+  std::vector<std::int64_t> hc_corner_stamp;
+  std::vector<double> hc_corner_x_prev_m;
+  std::vector<double> hc_corner_rate_filtered_m_s;
 
   // ---- Broad phase only (broad_phase.cpp; sized on its first call) ----------------------------
   bool broad_leaves_fitted = false;                  // node-tree leaves re-fitted once to the real margin

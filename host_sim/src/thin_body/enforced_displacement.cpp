@@ -18,7 +18,8 @@
 //     pushed a held node in) goes back to the plane it was held on, else to the nearest one.
 //     This covers the tool's area between nodes and its rim.
 // Colliding soft nodes = nodes moved this step, plus nodes held last step that are still within
-// release_distance in front of their plane (hysteresis against contact-set chatter). Every
+// release_distance in front of their plane (hysteresis against contact-set chatter; their force
+// share ramps smoothly from 1 on the face to 0 at release_distance, CollisionData::node_share). Every
 // triangle around a colliding node is in the force set (paper: "at least one of the nodes
 // belonging to the triangle is in a colliding state"), pushing along its node's plane.
 // ray (the paper's Fig. 3 right): every tool node in contact, excluded or not, puts its triangle's
@@ -73,6 +74,7 @@ struct Writer {
                            static_cast<btScalar>(p_world.z()));
     soft_node.m_v.setValue(static_cast<btScalar>(v_world.x()), static_cast<btScalar>(v_world.y()),
                            static_cast<btScalar>(v_world.z()));
+    data.node_share[n] = 1.0;  // on the face: the node's whole share of the force
     if (data.moved_stamp[n] != frame.step) {
       data.moved_stamp[n] = frame.step;
       data.moved_nodes.push_back(node);
@@ -227,14 +229,21 @@ DisplacementCounts enforce_displacement(const CollisionModel& model, const StepF
     writer.ray_only();
   }
   // Hysteresis: a node held last step and still within release_distance in front of its plane
-  // stays colliding (not moved).
+  // stays colliding (not moved), with a share of its force that ramps (smoothstep) from 1 on the
+  // face to 0 at release_distance (normal_displacement, hunt_crossley_force.cpp): the node's force
+  // fades out as it separates instead of dropping by a whole node's worth at the release. The
+  // ramp is wide (2 mm) so that the dither of a held tool (tens of µm) changes a hovering node's
+  // share by a few % only — the share's slope adds to the contact stiffness.
   const auto& planes = model.tool.planes();
+  const double release_m = model.params.release_distance_m;
   for (const int node : data.candidate_nodes) {
     const auto n = static_cast<std::size_t>(node);
     if (data.hold_stamp[n] != frame.step - 1 || data.moved_stamp[n] == frame.step) continue;
     const ToolPlane& plane = planes[static_cast<std::size_t>(data.hold_plane[n])];
     const double gap = plane.normal_tool.dot(data.end_tool_m[n]) - plane.offset_m;
-    if (gap < 0.0 || gap > model.params.release_distance_m) continue;
+    if (gap < 0.0 || gap > release_m) continue;
+    const double u = release_m > 0.0 ? gap / release_m : 0.0;
+    data.node_share[n] = 1.0 - u * u * (3.0 - 2.0 * u);  // smoothstep: flat at the face and at the release
     data.hold_stamp[n] = frame.step;
     data.moved_stamp[n] = frame.step;
     data.moved_nodes.push_back(node);

@@ -1,16 +1,39 @@
 // Stage 5: contact force, Hunt-Crossley per deformed triangle (BRIEF §3 item 5, §4; paper "The
 // interaction force model").
 //
-// For every triangle with at least one colliding node (the contacted faces):
-//   x  = |centroid now − rest centroid|                       (paper)
-//   ẋ  = first-order low-pass of (x − x_prev)/dt, α = dt / (dt + 1/(2π·fc)); the filter state
-//        restarts at 0 when a triangle enters contact (x_prev then = its x at the start of the
-//        step, from m_q), so there is no damping kick at first touch. Lag ≈ 1/(2π·fc).
-//   F  = w·(k·xⁿ + λ·xⁿ·ẋ), clamped F ≥ 0 (pulling back faster than k/λ would go negative),
-//        w = rest area (per_unit_area, default: refining the mesh converges the total) or 1 (the
-//        paper's per-triangle sum, which grows with mesh density).
-// Each triangle pushes the tool along the inward normal of the tool plane it lies on; the sum is
-// the force on the tool.
+// For every triangle with at least one colliding node (the contacted faces), held on the tool
+// plane with outward normal n (the tool pushes the soft surface along n):
+//
+// normal_displacement (default) — per colliding vertex v of the triangle (share s_v, see below):
+//   x_v = max(0, n·(q − p_v,rest))     how far the tool face (q: a point on it) has advanced along n
+//                                      past the vertex's rest position; for a vertex held on the
+//                                      face (gap ≈ skin) this is its displacement from rest along n
+//   F   = Σ_v s_v·(w/3)·max(0, k·x_vⁿ + λ·x_vⁿ·ẋ_v)
+//   x_v depends on the tool pose and the rest shape only, so ẋ_v is the tool's approach speed
+//   along n (no differentiated node noise); which vertices collide, and their shares s_v, come
+//   from the soft body's state.
+//   Why: the paper's centroid distance counts every motion of the triangle as indentation —
+//   sliding along the face, wrapping round the rim, the whole body sagging or rolling (a clamp
+//   jaw that had squeezed the ball held it with ~30 N after opening; a 10 m/s plunge left 36 N
+//   sideways). Along n only the part the tool actually pushed counts. And because x is measured
+//   per vertex, a node that joins the contact set where the face meets its rest position adds
+//   ≈ 0 (under the centroid measure the triangle's whole x came in with it: a coarse ball under a
+//   held plate jumped between 1.5 N / 6 triangles and 4 N / 13 triangles at ~0.2 mm of depth),
+//   and a held node leaving the face fades out over release_distance (s_v ramps 1 → 0,
+//   enforced_displacement.cpp) instead of dropping a triangle's worth in one step. Summed over
+//   the triangles around it, vertex v carries s_v·k·x_vⁿ·(its third of each adjacent area): a
+//   nodal quadrature of the contact pressure k·xⁿ over the contacted surface.
+//
+// centroid_distance (the paper's, kept for fidelity):
+//   x  = |centroid now − rest centroid|, F = w·c·(k·xⁿ + λ·xⁿ·ẋ), c = colliding vertices / 3 in
+//   per-unit-area mode (the contact indicator interpolated over the triangle), 1 otherwise.
+//
+// Both: ẋ = first-order low-pass of (x − x_prev)/dt, α = dt / (dt + 1/(2π·fc)); the filter state
+//   restarts at 0 when a triangle (corner) enters contact, x_prev then taken at the start of the
+//   step (m_q), so there is no damping kick at first touch. Lag ≈ 1/(2π·fc). F is clamped ≥ 0
+//   (pulling back faster than k/λ would go negative). w = rest area (per_unit_area, default:
+//   refining the mesh converges the total) or 1 (the paper's per-triangle sum, which grows with
+//   mesh density). Each triangle pushes the tool along −n; the sum is the force on the tool.
 #include "collision_state.hpp"
 
 #include <BulletSoftBody/btSoftBody.h>
@@ -22,13 +45,27 @@
 namespace fissure::host::thin_body {
 namespace {
 
+Eigen::Vector3d to_eigen(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
+
 Eigen::Vector3d centroid(const SoftSurfaceModel& surface, const btSoftBody& soft, int face, bool start_of_step) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  for (const int node : surface.face_nodes[static_cast<std::size_t>(face)]) {
-    const btVector3& p = start_of_step ? soft.m_nodes[node].m_q : soft.m_nodes[node].m_x;
-    sum += Eigen::Vector3d(p.x(), p.y(), p.z());
-  }
+  for (const int node : surface.face_nodes[static_cast<std::size_t>(face)])
+    sum += to_eigen(start_of_step ? soft.m_nodes[node].m_q : soft.m_nodes[node].m_x);
   return sum / 3.0;
+}
+
+// One low-pass step of ẋ for a filter slot; restarts (ẋ = 0, x_prev = x_start) when the slot was
+// not in contact the step before.
+double filtered_rate(std::int64_t& stamp, double& x_prev_m, double& rate_m_s, std::int64_t step, double x_m,
+                     double x_start_m, double dt_s, double alpha) {
+  if (stamp != step - 1) {
+    x_prev_m = x_start_m;
+    rate_m_s = 0.0;
+  }
+  rate_m_s += alpha * ((x_m - x_prev_m) / dt_s - rate_m_s);
+  stamp = step;
+  x_prev_m = x_m;
+  return rate_m_s;
 }
 
 }  // namespace
@@ -39,40 +76,67 @@ void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, co
   const double time_constant_s = 1.0 / (2.0 * std::numbers::pi * model.params.velocity_filter_cutoff_hz);
   const double alpha = frame.dt_s / (frame.dt_s + time_constant_s);
   const auto& planes = model.tool.planes();
+  const bool normal_measure = hc.measure == DeformationMeasure::kNormalDisplacement;
   for (const int face : data.contacted_faces) {
     const auto f = static_cast<std::size_t>(face);
     const Eigen::Vector3d c_now = centroid(model.soft, soft, face, false);
-    const double x = (c_now - model.soft.rest_centroid_world_m[f]).norm();
-    double rate_filtered = 0.0;
-    double x_prev = 0.0;
-    if (data.hc_stamp[f] == frame.step - 1) {
-      x_prev = data.hc_x_prev_m[f];
-      rate_filtered = data.hc_rate_filtered_m_s[f];
-    } else {
-      x_prev = (centroid(model.soft, soft, face, true) - model.soft.rest_centroid_world_m[f]).norm();
-    }
-    const double rate_raw = (x - x_prev) / frame.dt_s;
-    rate_filtered += alpha * (rate_raw - rate_filtered);
-    data.hc_stamp[f] = frame.step;
-    data.hc_x_prev_m[f] = x;
-    data.hc_rate_filtered_m_s[f] = rate_filtered;
-
-    // Per unit area the sum is a quadrature of k·xⁿ over the contacted surface. A triangle at the
-    // rim of the patch has only some vertices on the tool: counting its whole area there adds a
-    // ring one edge wide (an O(h) error — with the whole area, 1280/5120/20480 faces gave
-    // 1.47/1.25/1.19 N at 4 mm). Its contacted share is taken as the fraction of its vertices
-    // that are colliding (the contact indicator interpolated linearly over the triangle).
-    double contacted_share = 1.0;
-    if (hc.per_unit_area) {
-      int colliding = 0;
-      for (const int node : model.soft.face_nodes[f]) colliding += data.moved_stamp[static_cast<std::size_t>(node)] == frame.step ? 1 : 0;
-      contacted_share = colliding / 3.0;
-    }
-    const double weight = hc.per_unit_area ? contacted_share * model.soft.rest_area_m2[f] : 1.0;
-    const double x_pow_n = std::pow(x, hc.n);
-    const double force = std::max(0.0, weight * (hc.k * x_pow_n + hc.lambda * x_pow_n * rate_filtered));
     const int plane_index = data.face_plane[f];
-    const Eigen::Vector3d normal_world = frame.r_cur * planes[static_cast<std::size_t>(plane_index)].normal_tool;
+    const ToolPlane& plane = planes[static_cast<std::size_t>(plane_index)];
+    const Eigen::Vector3d normal_world = frame.r_cur * plane.normal_tool;
+    const Eigen::Vector3d normal_prev_world = frame.r_prev * plane.normal_tool;
+    const double area_weight = hc.per_unit_area ? model.soft.rest_area_m2[f] : 1.0;
+
+    double force = 0.0;
+    double x_record = 0.0;
+    double rate_record = 0.0;
+    double weight = 0.0;
+    if (normal_measure) {
+      double share_sum = 0.0;
+      double share_x_pow_n = 0.0;
+      double share_x_pow_n_rate = 0.0;
+      for (std::size_t corner = 0; corner < 3; ++corner) {
+        const int node = model.soft.face_nodes[f][corner];
+        const auto v = static_cast<std::size_t>(node);
+        if (data.moved_stamp[v] != frame.step) continue;  // not a colliding vertex
+        const double share = data.node_share[v];
+        const Eigen::Vector3d& rest = model.soft.rest_node_world_m[v];
+        const double x = std::max(0.0, plane.offset_m + normal_world.dot(frame.t_cur - rest));
+        const double x_start = std::max(0.0, plane.offset_m + normal_prev_world.dot(frame.t_prev - rest));
+        const std::size_t slot = 3 * f + corner;
+        const double rate = filtered_rate(data.hc_corner_stamp[slot], data.hc_corner_x_prev_m[slot],
+                                          data.hc_corner_rate_filtered_m_s[slot], frame.step, x, x_start, frame.dt_s, alpha);
+        const double x_pow_n = std::pow(x, hc.n);
+        force += share * (area_weight / 3.0) * std::max(0.0, hc.k * x_pow_n + hc.lambda * x_pow_n * rate);
+        share_sum += share;
+        share_x_pow_n += share * x_pow_n;
+        share_x_pow_n_rate += share * x_pow_n * rate;
+      }
+      // One record per triangle that reproduces its elastic part: weight·k·xⁿ = Σ s_v·(w/3)·k·x_vⁿ.
+      weight = area_weight * share_sum / 3.0;
+      x_record = share_sum > 0.0 ? std::pow(share_x_pow_n / share_sum, 1.0 / hc.n) : 0.0;
+      rate_record = share_x_pow_n > 0.0 ? share_x_pow_n_rate / share_x_pow_n : 0.0;
+    } else {
+      const double x = (c_now - model.soft.rest_centroid_world_m[f]).norm();
+      const double x_start = (centroid(model.soft, soft, face, true) - model.soft.rest_centroid_world_m[f]).norm();
+      const double rate =
+          filtered_rate(data.hc_stamp[f], data.hc_x_prev_m[f], data.hc_rate_filtered_m_s[f], frame.step, x, x_start, frame.dt_s, alpha);
+      // Per unit area the sum is a quadrature of k·xⁿ over the contacted surface. A triangle at the
+      // rim of the patch has only some vertices on the tool: counting its whole area there adds a
+      // ring one edge wide (an O(h) error — with the whole area, 1280/5120/20480 faces gave
+      // 1.47/1.25/1.19 N at 4 mm). Its contacted share is taken as the fraction of its vertices
+      // that are colliding (the contact indicator interpolated linearly over the triangle).
+      double contacted_share = 1.0;
+      if (hc.per_unit_area) {
+        int colliding = 0;
+        for (const int node : model.soft.face_nodes[f]) colliding += data.moved_stamp[static_cast<std::size_t>(node)] == frame.step ? 1 : 0;
+        contacted_share = colliding / 3.0;
+      }
+      weight = contacted_share * area_weight;
+      const double x_pow_n = std::pow(x, hc.n);
+      force = std::max(0.0, weight * (hc.k * x_pow_n + hc.lambda * x_pow_n * rate));
+      x_record = x;
+      rate_record = rate;
+    }
     out.force_on_tool_world_n -= force * normal_world;
 
     ContactRecord record;
@@ -82,8 +146,8 @@ void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, co
     record.jaw = model.params.jaw;
     record.point_world_m = c_now;
     record.normal_world = normal_world;
-    record.penetration_m = x;
-    record.penetration_rate_m_s = rate_filtered;
+    record.penetration_m = x_record;
+    record.penetration_rate_m_s = rate_record;
     record.weight = weight;
     record.force_n = force;
     out.contacts.push_back(record);

@@ -106,8 +106,14 @@ struct ToolDescription {
 /// rest triangle area (mesh-independent); per_triangle: the paper's one force per triangle.
 enum class HuntCrossleyMode : std::uint8_t { kPerUnitArea, kPerTriangle };
 
+/// What x measures (thin_body_collision.hpp DeformationMeasure): normal_displacement (default;
+/// per colliding node, along the tool face normal, from its rest position) or centroid_distance
+/// (the paper's |centroid − rest centroid| per triangle).
+enum class DeformationMeasureKind : std::uint8_t { kNormalDisplacement, kCentroidDistance };
+
 struct HuntCrossleyDescription {
   HuntCrossleyMode mode = HuntCrossleyMode::kPerUnitArea;
+  DeformationMeasureKind deformation_measure = DeformationMeasureKind::kNormalDisplacement;
   double exponent_n = 1.5;
   double stiffness_k = 0.0;   ///< per_unit_area: Pa/mⁿ = N/m⁽ⁿ⁺²⁾; per_triangle: N/mⁿ
   double damping_lambda = 0.0;  ///< per_unit_area: Pa·s/m⁽ⁿ⁺¹⁾; per_triangle: N·s/m⁽ⁿ⁺¹⁾

@@ -23,8 +23,24 @@ namespace fissure::host {
 
 enum class CollisionMethod { kPaired, kRay, kBullet };
 
-// F = k·xⁿ + λ·xⁿ·ẋ for x ≥ 0, clamped to F ≥ 0 (BRIEF §4; Hunt & Crossley 1975), one term per
-// deformed triangle with at least one colliding node, x = |centroid − rest centroid|.
+// What the Hunt-Crossley deformation x of a contacted triangle measures (docs/scenes.md).
+enum class DeformationMeasure {
+  // Default. Per colliding soft node v of the triangle: x_v = max(0, n·(q − p_v,rest)), how far
+  // the tool face (a point q on it, outward normal n) has advanced along n past the node's rest
+  // position — for a node held on the face, its displacement from rest along n. Sliding along the
+  // face, wrapping round the rim and sag add no force, and x follows the tool pose exactly (no
+  // node noise); a node that enters contact where the face meets its rest position starts at
+  // x ≈ 0, and a held node's share of the force ramps down over release_distance as it
+  // separates, so taking or releasing one node changes the force continuously instead of by a
+  // whole triangle's worth.
+  kNormalDisplacement,
+  // The paper's: x = |centroid − rest centroid| per triangle (fidelity; counts tangential motion
+  // of the triangle as indentation, and the contacted share changes in thirds of a triangle).
+  kCentroidDistance,
+};
+
+// F = k·xⁿ + λ·xⁿ·ẋ for x ≥ 0, clamped to F ≥ 0 (BRIEF §4; Hunt & Crossley 1975), for every
+// deformed triangle with at least one colliding node; x per `measure`.
 struct HuntCrossleyParams {
   double k = 2.0e5;       // per_unit_area: N/m^(n+2) (× rest area m² → N/mⁿ); else N/mⁿ per triangle
   double lambda = 50.0;   // per_unit_area: N·s/m^(n+3); else N·s/m^(n+1) per triangle
@@ -33,6 +49,7 @@ struct HuntCrossleyParams {
   // area (rest area × colliding vertices / 3), so refining the mesh converges the force; false:
   // the paper's plain per-triangle sum.
   bool per_unit_area = true;
+  DeformationMeasure measure = DeformationMeasure::kNormalDisplacement;
 };
 
 struct ThinBodyCollisionParams {
@@ -43,10 +60,13 @@ struct ThinBodyCollisionParams {
   // A tool node within this distance in front of a soft triangle counts as touching it (keeps a
   // resting contact from flickering at slow speeds).
   double contact_distance_m = 1.0e-5;
-  // A soft node held on the tool stays a colliding node (its triangles keep their force) until it
-  // separates from the tool face by more than this: hysteresis against contact-set chatter when
-  // the soft body's own dynamics lift a held node by a hair.
-  double release_distance_m = 2.0e-4;
+  // A soft node held on the tool stays a colliding node until it separates from the tool face by
+  // more than this: hysteresis against contact-set chatter when the soft body's own dynamics lift
+  // a held node. Under normal_displacement its force share ramps (smoothstep) from 1 on the face
+  // to 0 here, so this is also the width over which a separating node's force fades: 2 mm keeps
+  // the share's slope small against a held tool's ±40 µm encoder dither (0.2 mm, the former
+  // value, put ~7 N/mm of extra stiffness on the coarse ball: force steps of 15 % per dither step).
+  double release_distance_m = 2.0e-3;
   // ẋ is a finite difference of x filtered by a first-order low-pass with this cut-off
   // (time constant 1/(2π·fc), i.e. ≈1.6 ms lag at 100 Hz).
   double velocity_filter_cutoff_hz = 100.0;
@@ -66,10 +86,14 @@ struct ContactRecord {
   int jaw = 0;                        // ThinBodyCollisionParams::jaw
   Eigen::Vector3d point_world_m = Eigen::Vector3d::Zero();   // triangle centroid after the response
   Eigen::Vector3d normal_world = Eigen::Vector3d::Zero();    // tool face outward normal (world)
-  double penetration_m = 0.0;         // HC deformation x: |centroid − rest centroid|
-  double penetration_rate_m_s = 0.0;  // filtered ẋ
+  double penetration_m = 0.0;         // HC deformation x. centroid_distance: |centroid − rest centroid|;
+                                      // normal_displacement: the share-weighted n-mean of its colliding
+                                      // vertices' x_v, (Σ s_v·x_vⁿ / Σ s_v)^(1/n), so that
+                                      // weight·k·penetrationⁿ = this triangle's elastic force
+  double penetration_rate_m_s = 0.0;  // filtered ẋ (normal_displacement: Σ s_v·x_vⁿ·ẋ_v / Σ s_v·x_vⁿ)
   double weight = 1.0;                // per-unit-area mode: contacted share of the rest area (m²) = rest
-                                      // area × (colliding vertices / 3); 1 otherwise
+                                      // area × (Σ colliding-vertex shares s_v / 3; centroid_distance:
+                                      // s_v = 1); per-triangle mode: the same without the area
   double force_n = 0.0;               // this triangle's HC force magnitude (≥ 0)
 };
 
