@@ -6,11 +6,13 @@ The fixture is a small but complete `fissure bench all --out DIR` directory (tri
 errors, 5 crossed nodes at one pareto node spacing, a failed stress case) and one benchmark child
 (view) failed. Checks: the report has every section issue 7 requires, every image it links
 exists and is a PNG, the machine is named, met targets say "met", missed ones say "MISSED" (never
-"met"), the failed child is reported, and a benchmark whose JSON is missing is reported as such
-instead of vanishing.
+"met"), the failed child is reported, a benchmark whose JSON is missing is reported as such
+instead of vanishing, the 10 m/s plunge frames are embedded, and a failed render's stale frame
+is not.
 usage: report_test.py TOOLS_REPORT_DIR FIXTURE_DIR
 Exit 77 (ctest SKIP_RETURN_CODE) when matplotlib is missing.
 """
+import json
 import os
 import re
 import shutil
@@ -67,7 +69,16 @@ def main():
         # Written as docs/benchmarks.md with images in docs/images/bench: links must be relative to docs/.
         md = os.path.join(tmp, "docs", "benchmarks.md")
         images = os.path.join(tmp, "docs", "images", "bench")
-        result = run(script, fixture, md, images)
+        # The fixture plus the two 10 m/s plunge frames bench all renders (tiny stand-in PNGs).
+        full = os.path.join(tmp, "full")
+        shutil.copytree(fixture, full)
+        import matplotlib.pyplot as plt
+        for method in ("bullet", "paired"):
+            os.makedirs(os.path.join(full, "plunge-" + method))
+            fig = plt.figure(figsize=(1, 1))
+            fig.savefig(os.path.join(full, "plunge-" + method, "frame_000000.png"))
+            plt.close(fig)
+        result = run(script, full, md, images)
         check(result.returncode == 0, f"make_report.py exited {result.returncode}: {result.stderr.strip()}")
         if not os.path.exists(md):
             print("\n".join(failures))
@@ -90,7 +101,8 @@ def main():
                 with open(path, "rb") as f:
                     check(f.read(8) == b"\x89PNG\r\n\x1a\n", f"{link} is not a PNG")
         for name in ["pareto_host_rate.png", "pareto_node_spacing.png", "pareto_substeps.png", "pareto_fk_tolerance.png",
-                     "tunnelling.png", "rt_latency_vs_cyclictest.png", "cost_vs_mesh.png", "zwidth_vs_rate.png"]:
+                     "tunnelling.png", "rt_latency_vs_cyclictest.png", "cost_vs_mesh.png", "zwidth_vs_rate.png",
+                     "plunge_10mps_bullet.png", "plunge_10mps_paired.png"]:
             check(any(link.endswith("/" + name) for link in links), f"plot not linked: {name}")
 
         expectations = {
@@ -116,14 +128,21 @@ def main():
 
         # A benchmark with no JSON: reported, its targets "not checked", never silently gone.
         partial = os.path.join(tmp, "partial")
-        shutil.copytree(fixture, partial)
+        shutil.copytree(full, partial)
         os.remove(os.path.join(partial, "pareto.json"))
+        # A failed render child: its (stale) frame must not be shown.
+        record_path = os.path.join(partial, "bench_all.json")
+        record = json.load(open(record_path))
+        record["children"]["plunge_bullet"] = {"name": "plunge_bullet", "command": "fissure render", "exit_code": 1, "signal": 0,
+                                               "error": "", "ok": False, "wall_s": 1.0}
+        json.dump(record, open(record_path, "w"))
         md2 = os.path.join(tmp, "partial.md")
         result = run(script, partial, md2, os.path.join(tmp, "partial-images"))
         check(result.returncode == 0, f"make_report.py without pareto.json exited {result.returncode}: {result.stderr.strip()}")
         if os.path.exists(md2):
             report2 = open(md2).read()
             check("*No data: no pareto.json.*" in report2, "a missing pareto.json is not reported in its section")
+            check("*No 10 m/s plunge frames" in report2, "a failed plunge render still shows a frame")
             row = target_row(report2, "0 crossed nodes at every node spacing setting")
             check(row is not None and row[4] == "not checked", "targets of a missing benchmark are not 'not checked'")
     if failures:
