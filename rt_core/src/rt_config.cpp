@@ -36,6 +36,10 @@ const char* check_config(const RtConfig& c) noexcept {
   if (!non_negative(c.proxy.fade_s)) return "proxy.fade_s must be ≥ 0";
   if (!non_negative(c.passivity.max_damping_n_s_per_m)) return "passivity.max_damping_n_s_per_m must be ≥ 0";
   if (!positive(c.passivity.min_speed_m_per_s)) return "passivity.min_speed_m_per_s must be > 0";
+  if (!positive(c.passivity.margin_j)) return "passivity.margin_j must be > 0";
+  if (!positive(c.passivity.max_correction_step_n)) return "passivity.max_correction_step_n must be > 0";
+  if (!positive(c.passivity.dissipation_time_s)) return "passivity.dissipation_time_s must be > 0";
+  if (!non_negative(c.passivity.damping_ramp_s)) return "passivity.damping_ramp_s must be ≥ 0";
   if (!(positive(c.safety.max_force_n) && c.safety.max_force_n <= kFalconMaxForce_n)) {
     return "safety.max_force_n must be in (0, 8] N (the Falcon's rating)";
   }

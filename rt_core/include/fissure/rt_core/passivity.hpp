@@ -1,5 +1,7 @@
 #pragma once
-// Pipeline stage: time-domain passivity observer / controller (Hannaford & Ryu 2002).
+// Pipeline stage: time-domain passivity observer / controller (Hannaford & Ryu 2002), with a
+// controller that never steps the force (reference-energy following, Ryu, Preusche,
+// Hannaford & Hirzinger 2005, and per-tick force bounds as in Kim & Ryu's energy bounding).
 //
 // Observer: the energy the rendered force has put into the operator's hand since start,
 //     E = Σ F_in_effect · Δp_device       [J]   (= Σ f·v·T with v = Δp/T)
@@ -10,49 +12,112 @@
 // has absorbed at least as much energy as it returned); E > 0 means it created energy —
 // the precursor of the buzzing/instability Colgate & Schenkel's bound b > K·T/2 predicts.
 //
-// Controller: before a force goes out, predict the energy at the end of the interval it will
-// act in, E' = E + (F_sent + F)·v·T (F_sent: the command already on its way, acting until
-// the next exchange; F: this one, acting the interval after). If E' > 0, take away the
-// part of F along the motion that makes E' positive: first the component of F pushing
-// along v (the environment returning energy), then, if that is not enough, a damping force
-// of at most max_damping_n_s_per_m·|v|. This is Hannaford & Ryu's PC with the added damper
-// bounded: a virtual damper delayed by the ping-pong and the velocity filter is itself
-// subject to the sampled-data limit b > K·T/2 + |B| (Colgate & Schenkel 1997), so B must
-// stay below the device's own damping; removing a push along v is always safe. Telemetry
-// reports the equivalent damping removed/|v|. v is whichever of the filtered and the raw
-// velocity predicts more energy out (the filter lags ~3 ms; the raw difference does not).
+// Controller. Predicted energy at the end of the interval this tick's force acts in:
+//     E' = E + (F_sent + F)·v·T       (F_sent: the command already on its way)
+// The correction it applies is smooth by construction — two rate-limited quantities:
+//   * r [N], a reduction of the environment force along the force's own direction:
+//         F_out = F − min(r, |F|)·F̂ − β·v_f
+//     F̂ is the contact normal (stable in contact), not v̂ (which flips with every encoder
+//     count at standstill), so the correction does not jump when the motion reverses.
+//     r heads for the amount that would bring E' back to the reference −margin in one tick
+//     while the environment is returning energy (F·v_f > 0) and E' > −margin; it heads for 0
+//     otherwise. Per tick r moves by at most
+//         Δr_max = max_correction_rate_n_per_s · T · (1 + max(0, E')/margin)
+//     i.e. a ramp the hand does not feel as a click while the loop is nearly passive (E' ≤
+//     0: 0.05 N per tick at 1 kHz, the same bound as a proxy swap), faster in proportion to
+//     how much energy has really been created (a loop far beyond its Z-width must be caught
+//     within a few ticks; at E' = 10·margin the ramp is 11× steeper).
+//   * β [N·s/m], a damper on the filtered velocity v_f, ramped between 0 and
+//     max_damping_n_s_per_m over damping_ramp_s: full while E' > −margin, zero otherwise.
+//     v_f is continuous (2nd-order low-pass), so β·v_f has no steps either. β is bounded
+//     below the device's own damping: a virtual damper behind the ping-pong latency and the
+//     filter lag is itself subject to the sampled-data limit b > K·T/2 + |B| (Colgate &
+//     Schenkel 1997).
+// Reference energy −margin: the controller starts before E reaches zero, so it can spread the
+// dissipation over many ticks instead of removing it all in the tick E crosses zero (the
+// chatter of the plain Hannaford–Ryu controller: a 2.3 N step per encoder count at a hold).
+// The cost is that E may overshoot 0 briefly; what the observer sees is still returned.
+// Below min_speed_m_per_s r and β hold their values: the direction of v_f is noise there, and
+// a force at standstill does no work.
 #include <Eigen/Core>
 
 namespace fissure::rt {
 
+/// Reference energy margin [J]: the observer's own resolution at the Falcon's rated force —
+/// one encoder count (≈ 50 µm at the workspace centre, BRIEF §6) of motion under 8 N is
+/// 0.4 mJ, so an E within that of zero is indistinguishable from zero.
+inline constexpr double kDefaultPassivityMargin_j = 8.0 * 50e-6;
+/// Largest change of the force reduction per tick while E' ≤ 0 [N]: the bound issue 6 sets
+/// for a proxy swap (max |ΔF| per tick ≤ 0.05 N) — the same "no felt click" criterion applies
+/// to the controller's own force changes.
+inline constexpr double kDefaultPassivityCorrectionStep_n = 0.05;
+/// Cap of the urgency factor 1 + E'/margin that steepens the reduction's ramp once energy
+/// has really been created: at most 4 × 0.05 = 0.2 N per tick. Uncapped, a large E' turned the
+/// ramp back into the one-tick switch this controller replaces.
+inline constexpr double kPassivityMaxUrgency = 40.0;
+/// Energy scale of the urgency factor, in margins: 1 + E'/(10·margin), i.e. twice as steep
+/// at E' = 4 mJ, 7× at the stress harness's 25 mJ bound.
+inline constexpr double kPassivityUrgencyMargins = 10.0;
+/// Time over which the controller aims to dissipate the excess energy [s] (reference-energy
+/// following): 50 ms, a few periods of the hand–device resonance (≈ 7 Hz with a 300 N/m grip)
+/// and of a stiff contact (≈ 20–70 Hz), so the correction stays a small, smooth force.
+inline constexpr double kDefaultPassivityDissipationTime_s = 0.05;
+/// Time for the added damper to go from 0 to max_damping_n_s_per_m [s]: 20 ms, a few periods
+/// of a 3000 N/m wall on the Falcon's ~0.15 kg (≈ 22 Hz), far longer than a tick.
+inline constexpr double kDefaultPassivityDampingRamp_s = 0.02;
+
+/// After a device fault [s]: the work done while safety brings the force back (its
+/// kDefaultFaultRampIn_s = 0.25 s ramp-in, after FaultConfig's 20 clean ticks ≤ 40 ms at
+/// 500 Hz) is counted in E but attributed to the fault, not to the environment: the ramp
+/// pushes a hand that sank in while the force was off back out, and the controller holding
+/// the contact force down for it would leave the wall soft long after the fault cleared.
+inline constexpr double kPassivityRecoveryWindow_s = 0.3;
+
 struct PassivityConfig {
   bool enabled = true;
-  /// Largest damping the controller may add beyond cancelling the force along v [N·s/m].
-  /// Below SimFalcon's nominal mechanism damping (3 N·s/m) so that, by Colgate–Schenkel,
-  /// the added damper cannot itself become active. (CHAI3D's 20 N·s/m Falcon limit is for a
-  /// damper rendered with the hand's own damping added; the controller cannot count on it.)
+  /// Largest damping the controller may add [N·s/m]. Below SimFalcon's nominal mechanism
+  /// damping (3 N·s/m) so that, by Colgate–Schenkel, the added damper cannot itself become
+  /// active. (CHAI3D's 20 N·s/m Falcon limit is for a damper rendered with the hand's own
+  /// damping added; the controller cannot count on it.)
   double max_damping_n_s_per_m = 2.0;
-  /// Below this speed the controller does nothing [m/s]: the direction of v is noise there
-  /// (one encoder count per tick at 1 kHz reads ≈ 50 mm/s raw, ≲ 1 mm/s after the filter)
-  /// and a force at standstill does no work anyway.
+  /// Below this filtered speed the controller holds its correction [m/s]: one encoder count
+  /// per tick at 1 kHz reads ≈ 50 mm/s raw, ≲ 1 mm/s after the filter; the direction of v is
+  /// noise below that and a force at standstill does no work anyway.
   double min_speed_m_per_s = 1e-3;
+  /// Reference energy margin [J] (kDefaultPassivityMargin_j).
+  double margin_j = kDefaultPassivityMargin_j;
+  /// Largest change of the force reduction r per tick while E' ≤ 0 [N] (× the urgency factor
+  /// above that).
+  double max_correction_step_n = kDefaultPassivityCorrectionStep_n;
+  /// Time over which the excess above the reference is to be dissipated [s].
+  double dissipation_time_s = kDefaultPassivityDissipationTime_s;
+  /// 0 → max_damping_n_s_per_m ramp time of the added damper [s].
+  double damping_ramp_s = kDefaultPassivityDampingRamp_s;
 };
 
 struct PassivityState {
   double energy_j = 0.0;  ///< observer: Σ F·Δp since start (positive = active)
-  double dissipated_by_controller_j = 0.0;   ///< Σ removed·|v|·T the controller asked for
+  double dissipated_by_controller_j = 0.0;   ///< Σ −correction·v_f·T (what the controller took out)
   Eigen::Vector3d force_sent_last_device_n = Eigen::Vector3d::Zero();   ///< computed tick k−1
   Eigen::Vector3d force_acting_device_n = Eigen::Vector3d::Zero();      ///< computed tick k−2 (acting now)
   Eigen::Vector3d p_prev_device_m = Eigen::Vector3d::Zero();
   bool primed = false;
-  double damping_n_s_per_m = 0.0;  ///< equivalent damping removed/|v| in the last tick
+  double recovery_energy_j = 0.0;      ///< part of E done in fault-recovery windows (not the environment's)
+  double recovery_window_left_s = 0.0;
+  double reduction_fraction = 0.0;        ///< g: share of F taken off along F̂ [0, 1]
+  double reduction_n = 0.0;               ///< r = g·|F| in the last tick [N]
+  double added_damping_n_s_per_m = 0.0;   ///< β
+  /// Telemetry: the correction expressed as a damping, |F − F_out| / max(|v_f|, min_speed)
+  /// [N·s/m]; > 0 exactly when the controller changed the force this tick.
+  double damping_n_s_per_m = 0.0;
 };
 
 /// Observer: account the work done since the previous sample. Call once per good sample.
 void observe_energy(PassivityState& state, const Eigen::Vector3d& p_device_m) noexcept;
 
-/// Controller: returns the force with passivity damping added (unchanged when disabled
-/// or when the prediction stays ≤ 0).
+/// Controller: returns the force with the passivity correction applied (unchanged when
+/// disabled or while the correction is zero). v_raw is used only to predict the energy (it
+/// leads the filtered estimate by ~3 ms); the force uses v_filtered alone.
 Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState& state,
                                   const Eigen::Vector3d& force_device_n, const Eigen::Vector3d& v_filtered_m_per_s,
                                   const Eigen::Vector3d& v_raw_m_per_s, double period_s) noexcept;
@@ -61,7 +126,9 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
 void record_sent_force(PassivityState& state, const Eigen::Vector3d& force_device_n) noexcept;
 
 /// After a fault the device position history is not trustworthy: restart the Δp chain
-/// (the energy total is kept).
+/// (the energy total is kept), drop the correction (the force restarts from zero via
+/// safety's ramp-in anyway) and open a kPassivityRecoveryWindow_s window whose work is
+/// attributed to the fault (recovery_energy_j; the controller acts on E − recovery_energy_j).
 void restart_observer(PassivityState& state) noexcept;
 
 }  // namespace fissure::rt
