@@ -694,13 +694,10 @@ std::vector<StressCase> stress_cases() {
       "rt_core passivity: observer energy grows past the bound (controller cannot hold E <= 0 here)";
   const std::string crossing = "host_sim paired collision: a soft node ends on the wrong side of the tool";
   const std::pair<const char*, std::string> known[] = {
-      {"hc_k_1e+08", passivity},
       {"hc_lambda_over_k_10", passivity},
       {"hc_lambda_over_k_100", passivity},
       {"clamp_squeezes_sphere_flat", passivity},
-      {"hand_vibration_tick_rate", passivity},
       {"encoder_jumps", passivity},
-      {"link_corrupt_50%", passivity},
       {"device_dropped_torn_replies", crossing},
       {"host_step_20ms", crossing},
   };
