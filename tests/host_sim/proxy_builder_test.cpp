@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -15,6 +17,7 @@
 #include "fissure/host_sim/scene_loader.hpp"
 #include "fissure/rt_core/device_mapping.hpp"
 #include "fissure/rt_core/hunt_crossley.hpp"
+#include "fissure/rt_core/proxy_intake.hpp"
 #include "fissure/shared/message_validation.hpp"
 
 namespace fissure::host {
@@ -394,6 +397,101 @@ TEST_P(PaperSceneProxy, RtEvaluationAtTheHostPoseIsWithinOnePercentOfTheHostForc
   // The scene must actually exercise contact (otherwise the comparison says nothing).
   EXPECT_GT(steps_in_contact, 50) << GetParam();
   EXPECT_GT(peak_force, 0.5) << GetParam();
+}
+
+// Between host updates rt_core evaluates the proxy away from its reference pose and time. Here
+// the host steps at the scene's rate (1 kHz) along its scripted trajectory, but rt_core only gets
+// every 10th proxy (a 100 Hz host, issue 6's 2 % row) through its own intake (take_latest_proxy,
+// with the plane extrapolation) and evaluates it at each 1 kHz step's pose and speed; the host's
+// own force at that step is the truth. A proxy frozen at its reference pose misses how the soft
+// body keeps moving under a still tool (measured: ~20 N/s on spatula-sphere after the press).
+struct HeldProxyError {
+  double rms_n = 0.0;
+  double peak_host_n = 0.0;
+  int steps_in_contact = 0;
+};
+
+HeldProxyError held_proxy_error(const std::string& scene_name, int steps_per_proxy, bool extrapolate) {
+  const SceneDescription scene = load_scene(resolve_scene_path(scene_name));
+  HostSimulation sim(scene);
+  sim.settle(0.2);
+  const bool clamp = scene.tool.kind == ToolKind::kClamp;
+  ProxyBuilderModel model;
+  model.hunt_crossley.k = scene.hunt_crossley.stiffness_k;
+  model.hunt_crossley.lambda = scene.hunt_crossley.damping_lambda;
+  model.hunt_crossley.n = scene.hunt_crossley.exponent_n;
+  model.jaw_count = clamp ? 2 : 1;
+  for (int jaw = 0; jaw < model.jaw_count; ++jaw) {
+    const auto j = static_cast<std::size_t>(jaw);
+    model.plane_count[j] = static_cast<int>(sim.tool_nodes(jaw)->planes().size());
+    model.part_of_jaw[j] = clamp ? clamp_part_of_jaw(scene, jaw) : ToolPart::kTool;
+  }
+  ProxyBuilder builder(model);
+  rt::ProxyExtrapolation extrapolation;
+  extrapolation.enabled = extrapolate;
+  auto exchange = std::make_unique<rt::ProxyExchange>();
+  auto state = std::make_unique<rt::ProxyState>();
+
+  RtSide rt;
+  rt.mapping = scene.device_mapping;
+  const double dt = scene.simulation.time_step_s;
+  const int steps = static_cast<int>(std::floor(trajectory_duration_s(scene) / dt + 1e-9));
+  TrajectorySample previous = sample_trajectory(scene, 0.0);
+  HeldProxyError result;
+  double sum_sq = 0.0;
+  int compared = 0;
+  ContactProxy proxy;
+  for (int i = 1; i <= steps; ++i) {
+    const double t = i * dt;
+    const TrajectorySample target = sample_trajectory(scene, t);
+    ToolPose pose;
+    pose.position_world_m = as_eigen(target.pose.position_world_m);
+    const Quat& q = target.pose.orientation_world;
+    pose.orientation_world = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
+    const HostStepResult& step = sim.step(pose, target.jaw_gap_m);
+    rt.tool.p_tool_world_m = pose.position_world_m;
+    rt.tool.v_tool_world_m_per_s = (pose.position_world_m - as_eigen(previous.pose.position_world_m)) / dt;
+    if (clamp) {
+      rt.tool.jaw_closing_m = (scene.tool.clamp.jaw_gap_open_m - step.jaw_gap_m) / rt.mapping.scale;
+      rt.tool.jaw_closing_rate_m_per_s = (previous.jaw_gap_m - target.jaw_gap_m) / dt / rt.mapping.scale;
+    }
+    previous = target;
+    const auto now_ns = static_cast<TimeNs>(std::llround(step.time_s * 1e9));
+    // rt_core's view of this step, with the proxy it holds (built up to steps_per_proxy − 1 steps ago).
+    rt::take_latest_proxy(*exchange, *state, now_ns, extrapolation);
+    if (state->have_proxy) {
+      const Eigen::Vector3d error = rt.total(rt::active_proxy(*state)) - step.force_on_tool_world_n;
+      sum_sq += error.squaredNorm();
+      ++compared;
+    }
+    if (i % steps_per_proxy == 0) {
+      builder.build(step.contacts, pose, rt.parts(), now_ns, proxy);
+      exchange->publish(proxy);
+    }
+    if (step.contact_count > 0) ++result.steps_in_contact;
+    result.peak_host_n = std::max(result.peak_host_n, step.force_on_tool_world_n.norm());
+  }
+  result.rms_n = compared > 0 ? std::sqrt(sum_sq / compared) : 0.0;
+  return result;
+}
+
+// Stated tolerance: the proxy held over a 100 Hz host period, with rt_core's default intake,
+// stays within 2 % RMS (of the peak host force) of the host's own force at every displaced pose
+// (issue 6's 100 Hz target, here for the proxy model alone). The plane extrapolation (off by
+// default) is held to the same bound; both figures are printed.
+constexpr double kHeldProxyRmsTolerance = 0.02;
+
+TEST_P(PaperSceneProxy, ProxyHeldOverAHundredHertzPeriodTracksTheHostForceAtTheDisplacedPose) {
+  const int steps_per_proxy = 10;  // 1 kHz host steps per proxy: a 100 Hz host
+  const HeldProxyError held = held_proxy_error(GetParam(), steps_per_proxy, rt::ProxyExtrapolation{}.enabled);
+  const HeldProxyError extrapolated = held_proxy_error(GetParam(), steps_per_proxy, true);
+  ASSERT_GT(held.steps_in_contact, 50) << GetParam();
+  ASSERT_GT(held.peak_host_n, 0.5) << GetParam();
+  std::printf("%s: held 10 ms: rms %.3f %% of peak %.3f N (with plane extrapolation %.3f %%)\n", GetParam().c_str(),
+              100.0 * held.rms_n / held.peak_host_n, held.peak_host_n,
+              100.0 * extrapolated.rms_n / extrapolated.peak_host_n);
+  EXPECT_LE(held.rms_n, kHeldProxyRmsTolerance * held.peak_host_n) << GetParam();
+  EXPECT_LE(extrapolated.rms_n, kHeldProxyRmsTolerance * extrapolated.peak_host_n) << GetParam();
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, PaperSceneProxy,
