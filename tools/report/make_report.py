@@ -664,12 +664,21 @@ def section_view(report, data, problems, targets):
     if not view:
         missing(report, "view", problems)
         return
-    report.add(f"Host step time of `{view.get('scene', '?')}` paced at the real host rate, {view.get('repeats', '?')} "
-               "repeat(s) per row: nothing drawn, snapshots published, frames written, the window (when a display exists).")
+    report.add(f"`fissure run {view.get('scene', '?')}` in real time, {view.get('repeats', '?')} run(s) per row (median over "
+               "runs): without a view, writing frames, and with the window when a display exists — host step and rt "
+               "tick timings side by side, so any cost of the view shows up where it would hurt.")
     report.add("")
-    report.add(table(["configuration", "step median µs", "step p99 µs", "publish median µs", "frames written", "frames dropped"],
+
+    def publish_median(r):
+        # bench view ≥ 09fe51d writes capture_publish_us_median; older JSON had {median}.
+        flat = r.get("capture_publish_us_median")
+        return flat if flat is not None else r.get("capture_publish_us", {}).get("median")
+
+    report.add(table(["configuration", "host step median µs", "host step p99 µs", "rt tick interval p99 µs",
+                      "rt overruns", "publish median µs", "frames written", "frames dropped"],
                      [[r.get("configuration"), fmt(r.get("host_step_us", {}).get("median")),
-                       fmt(r.get("host_step_us", {}).get("p99")), fmt(r.get("capture_publish_us", {}).get("median")),
+                       fmt(r.get("host_step_us", {}).get("p99")), fmt(r.get("rt_tick_interval_us", {}).get("p99")),
+                       fmt(r.get("overruns")), fmt(publish_median(r)),
                        fmt(r.get("frames_written")), fmt(r.get("frames_dropped"))] for r in view.get("rows", [])]))
     report.add(targets_table([t for t in targets if t.section == "view"]))
 
