@@ -33,6 +33,7 @@
 #include <nlohmann/json.hpp>
 
 #include "machine_info.hpp"
+#include "shell_quote.hpp"
 
 namespace fissure::app {
 namespace {
@@ -92,18 +93,6 @@ std::vector<Child> children(const fs::path& out_dir) {
       plunge("bullet"),
       plunge("paired"),
   };
-}
-
-std::string shell_quote(const std::string& s) {
-  std::string out = "'";
-  for (const char c : s) {
-    if (c == '\'') {
-      out += "'\\''";
-    } else {
-      out += c;
-    }
-  }
-  return out + "'";
 }
 
 std::string join_command(const std::vector<std::string>& argv) {

@@ -8,24 +8,12 @@
 
 #include "commands.hpp"
 #include "fissure/rt_core/faults.hpp"
+#include "shell_quote.hpp"
 
 namespace fissure::app {
 namespace {
 
 double norm(const Vec3& v) { return as_eigen(v).norm(); }
-
-// Single-quotes a path for /bin/sh (system()).
-std::string shell_quote(const std::string& s) {
-  std::string out = "'";
-  for (const char c : s) {
-    if (c == '\'') {
-      out += "'\\''";
-    } else {
-      out += c;
-    }
-  }
-  return out + "'";
-}
 
 }  // namespace
 

@@ -1,0 +1,17 @@
+#include "shell_quote.hpp"
+
+namespace fissure::app {
+
+std::string shell_quote(const std::string& s) {
+  std::string out = "'";
+  for (const char c : s) {
+    if (c == '\'') {
+      out += "'\\''";
+    } else {
+      out += c;
+    }
+  }
+  return out + "'";
+}
+
+}  // namespace fissure::app
