@@ -46,7 +46,7 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision {
     out.guard_corrections = 0;
     out.seconds_narrow = out.seconds_response = out.seconds_force = 0.0;
 
-    make_frame(previous, current, dt_s);
+    frame_ = thin_body::make_step_frame(model_, data_.step, previous, current, dt_s);
     out.broad_phase_hit = thin_body::broad_phase(model_, frame_, soft, data_);
     const Clock::time_point t1 = Clock::now();
     out.seconds_broad = seconds_between(t0, t1);
@@ -86,25 +86,6 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision {
   }
 
  private:
-  void make_frame(const ToolPose& previous, const ToolPose& current, double dt_s) {
-    frame_.step = data_.step;
-    frame_.dt_s = dt_s;
-    frame_.r_prev = previous.orientation_world.normalized().toRotationMatrix();
-    frame_.t_prev = previous.position_world_m;
-    frame_.r_cur = current.orientation_world.normalized().toRotationMatrix();
-    frame_.t_cur = current.position_world_m;
-    frame_.velocity_world_m_s = (current.position_world_m - previous.position_world_m) / dt_s;
-    const Eigen::AngleAxisd rotation(frame_.r_cur * frame_.r_prev.transpose());
-    frame_.angular_velocity_world = rotation.axis() * (rotation.angle() / dt_s);
-    frame_.swept_tool_world_m.setEmpty();
-    const Eigen::AlignedBox3d& bounds = model_.tool.bounds_tool_m();
-    for (int corner = 0; corner < 8; ++corner) {
-      const Eigen::Vector3d p = bounds.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner));
-      frame_.swept_tool_world_m.extend(frame_.r_prev * p + frame_.t_prev);
-      frame_.swept_tool_world_m.extend(frame_.r_cur * p + frame_.t_cur);
-    }
-  }
-
   thin_body::CollisionModel model_;
   thin_body::CollisionData data_;
   thin_body::StepFrame frame_;

@@ -27,25 +27,9 @@ using test_scene::kStep_s;
 // CreateEllipsoid(res) gives 2·res + 2 faces: 63 → the paper's 128; 639 → 1280; 2559 → 5120; 10239 → 20480.
 int ellipsoid_resolution(int faces) { return (faces - 2) / 2; }
 
-// The collision's own frame construction (thin_body_collision.cpp make_frame), for the stages.
+// The collision's own frame construction, for driving the stages one by one.
 thin_body::StepFrame make_frame(const thin_body::CollisionModel& model, std::int64_t step, const ToolPose& previous, const ToolPose& current) {
-  thin_body::StepFrame frame;
-  frame.step = step;
-  frame.dt_s = kStep_s;
-  frame.r_prev = previous.orientation_world.normalized().toRotationMatrix();
-  frame.t_prev = previous.position_world_m;
-  frame.r_cur = current.orientation_world.normalized().toRotationMatrix();
-  frame.t_cur = current.position_world_m;
-  frame.velocity_world_m_s = (current.position_world_m - previous.position_world_m) / kStep_s;
-  const Eigen::AngleAxisd rotation(frame.r_cur * frame.r_prev.transpose());
-  frame.angular_velocity_world = rotation.axis() * (rotation.angle() / kStep_s);
-  frame.swept_tool_world_m.setEmpty();
-  for (int corner = 0; corner < 8; ++corner) {
-    const Eigen::Vector3d p = model.tool.bounds_tool_m().corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner));
-    frame.swept_tool_world_m.extend(frame.r_prev * p + frame.t_prev);
-    frame.swept_tool_world_m.extend(frame.r_cur * p + frame.t_cur);
-  }
-  return frame;
+  return thin_body::make_step_frame(model, step, previous, current, kStep_s);
 }
 
 Eigen::Vector3d to_eigen(const btVector3& v) { return {v.x(), v.y(), v.z()}; }

@@ -166,4 +166,26 @@ void allocate_collision_data(const CollisionModel& model, CollisionData& data) {
   data.hc_corner_rate_filtered_m_s.assign(3 * soft_faces, 0.0);
 }
 
+StepFrame make_step_frame(const CollisionModel& model, std::int64_t step, const ToolPose& previous,
+                          const ToolPose& current, double dt_s) {
+  StepFrame frame;
+  frame.step = step;
+  frame.dt_s = dt_s;
+  frame.r_prev = previous.orientation_world.normalized().toRotationMatrix();
+  frame.t_prev = previous.position_world_m;
+  frame.r_cur = current.orientation_world.normalized().toRotationMatrix();
+  frame.t_cur = current.position_world_m;
+  frame.velocity_world_m_s = (current.position_world_m - previous.position_world_m) / dt_s;
+  const Eigen::AngleAxisd rotation(frame.r_cur * frame.r_prev.transpose());
+  frame.angular_velocity_world = rotation.axis() * (rotation.angle() / dt_s);
+  frame.swept_tool_world_m.setEmpty();
+  const Eigen::AlignedBox3d& bounds = model.tool.bounds_tool_m();
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d p = bounds.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner));
+    frame.swept_tool_world_m.extend(frame.r_prev * p + frame.t_prev);
+    frame.swept_tool_world_m.extend(frame.r_cur * p + frame.t_cur);
+  }
+  return frame;
+}
+
 }  // namespace fissure::host::thin_body

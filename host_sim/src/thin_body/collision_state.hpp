@@ -121,6 +121,10 @@ struct CollisionData {
   int broad_faces_tested = 0;         // soft faces whose tool-frame swept box was tested
 };
 
+// The step's frame quantities (rotations, translations, velocities, swept tool bounds) from the
+// tool's pose at the start and at the end of the step.
+StepFrame make_step_frame(const CollisionModel& model, std::int64_t step, const ToolPose& previous,
+                          const ToolPose& current, double dt_s);
 CollisionModel build_collision_model(const ToolNodes& tool, const btSoftBody& soft,
                                      const ThinBodyCollisionParams& params, bool paired);
 void take_rest_state(const btSoftBody& soft, SoftSurfaceModel& model);
