@@ -81,7 +81,11 @@ void estimate_speeds(ProxyState& state, int from, int to, const ProxyExtrapolati
 ProxyIntake take_latest_proxy(ProxyExchange& exchange, ProxyState& state, TimeNs now_ns,
                               const ProxyExtrapolation& extrapolation) noexcept {
   // The active proxy at this tick (it becomes the previous one if a new proxy is accepted now).
-  if (state.have_proxy) extrapolate_to(state, state.active, state.accepted_at_ns, now_ns);
+  // A zero horizon (extrapolation off, the default, or no matched patch) leaves the rendered copy
+  // exactly as received, so the tick does no per-patch work then.
+  if (state.have_proxy && state.horizon_ns[static_cast<std::size_t>(state.active)] > 0) {
+    extrapolate_to(state, state.active, state.accepted_at_ns, now_ns);
+  }
 
   // Fetch straight into the inactive buffer. If the candidate is rejected, that buffer no
   // longer holds the previous proxy; the blend only needs it on an accepted swap (and reads
