@@ -2,6 +2,7 @@
 
 #include <sys/utsname.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -14,6 +15,8 @@
 #include <nlohmann/json.hpp>
 
 #include "stress_cases.hpp"
+#include "stress_parallel.hpp"
+#include "stress_row_json.hpp"
 
 namespace fissure::app {
 namespace {
@@ -26,6 +29,7 @@ struct StressOptions {
   std::uint64_t seed = kDefaultStressSeed;
   std::string json_path;
   std::vector<std::string> case_names;
+  unsigned jobs = 0;  ///< 0: one per core
   bool list = false;
 };
 
@@ -44,33 +48,6 @@ nlohmann::json machine_json() {
   utsname names{};
   if (uname(&names) == 0) machine["kernel"] = std::string(names.sysname) + " " + names.release;
   return machine;
-}
-
-nlohmann::json row_json(const StressRow& r) {
-  return {{"name", r.name},
-          {"group", r.group},
-          {"seed", r.seed},
-          {"passed", r.passed},
-          {"known_failure", r.known_failure},
-          {"failures", r.failures},
-          {"ticks", r.ticks},
-          {"host_steps", r.host_steps},
-          {"force_max_n", r.force_max_n},
-          {"force_limit_n", r.force_limit_n},
-          {"energy_max_j", r.energy_max_j},
-          {"energy_bound_j", r.energy_bound_j},
-          {"crossed_nodes_max", r.crossed_nodes_max},
-          {"host_penetration_max_mm", r.host_penetration_max_mm},
-          {"faults_seen", fault_bits_text(r.fault_bits_seen)},
-          {"faults_allowed", fault_bits_text(r.fault_bits_allowed)},
-          {"fault_onsets", r.fault_onsets},
-          {"proxies_rejected", r.proxies_rejected},
-          {"injected_events", r.injected_events},
-          {"recoveries_required", r.recoveries_required},
-          {"recoveries_done", r.recoveries_done},
-          {"recovery_max_s", r.recovery_max_s},
-          {"wall_s", r.wall_s},
-          {"note", r.note}};
 }
 
 void print_header() {
@@ -123,11 +100,20 @@ void run(const StressOptions& options) {
   std::vector<StressRow> rows;
   int failed = 0;
   int known = 0;
-  for (const StressCase& c : cases) {
-    rows.push_back(run_stress_case(c, profile, stress_case_seed(options.seed, c.name)));
-    print_row(rows.back());
-    if (!rows.back().passed && !rows.back().known_failure) ++failed;
-    if (rows.back().known_failure) ++known;
+  auto count_and_print = [&](const StressRow& row) {
+    print_row(row);
+    if (!row.passed && !row.known_failure) ++failed;
+    if (row.known_failure) ++known;
+  };
+  const unsigned jobs = options.jobs == 0 ? std::max(1u, std::thread::hardware_concurrency()) : options.jobs;
+  if (jobs == 1 || cases.size() == 1) {
+    // In this process: what a debugger wants, and the same rows as the forked run.
+    for (const StressCase& c : cases) {
+      rows.push_back(run_stress_case(c, profile, stress_case_seed(options.seed, c.name)));
+      count_and_print(rows.back());
+    }
+  } else {
+    rows = run_stress_cases_forked(cases, profile, options.seed, jobs, count_and_print);
   }
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf("%zu cases, %d failed, %d known failures (ci only), %.1f s\n", rows.size(), failed, known, wall_s);
@@ -144,11 +130,12 @@ void run(const StressOptions& options) {
     out["energy_bound_j"] = kStressEnergyBound_j;
     out["recovery_bound_s"] = kStressRecoveryBound_s;
     out["wall_s"] = wall_s;
+    out["jobs"] = jobs;
     out["failed"] = failed;
     out["known_failures"] = known;
     out["machine"] = machine_json();
     out["cases"] = nlohmann::json::array();
-    for (const StressRow& r : rows) out["cases"].push_back(row_json(r));
+    for (const StressRow& r : rows) out["cases"].push_back(stress_row_to_json(r));
     std::ofstream file(options.json_path);
     if (!file) throw CommandError("cannot write '" + options.json_path + "'");
     file << out.dump(2) << "\n";
@@ -167,6 +154,8 @@ void register_stress(CommandTree& tree) {
   cmd->add_option("--seed", options->seed, "base seed (each case derives its own from it and its name)");
   cmd->add_option("--json", options->json_path, "write the report rows as JSON to FILE");
   cmd->add_option("--case", options->case_names, "run only the named case(s) (repeatable)");
+  cmd->add_option("--jobs", options->jobs,
+                  "cases run side by side, each in its own process (default 0: one per core; 1: all in this process)");
   cmd->add_flag("--list", options->list, "list the cases and exit");
   cmd->callback([options] { run(*options); });
 }

@@ -118,6 +118,7 @@ def main():
             "zero overruns at 1 kHz over 30 s (idle machine)": "not checked",    # a 2 s run
             "no stress case fails (other than known failures)": "**MISSED**",    # one FAIL case
             "ci profile runs in under 5 minutes": "met",
+            "full profile passes (every case, ≥ 1e6 rt ticks each)": "not checked",  # no stress_full.json
         }
         for description, status in expectations.items():
             row = target_row(report, description)
@@ -125,6 +126,23 @@ def main():
             if row is not None:
                 check(row[4] == status, f"target '{description}': status '{row[4]}', expected '{status}'")
         check("**FAILED**: exit 1" in report, "the failed view child is not reported as FAILED")
+
+        # The full stress profile (bench all --stress-full): its own summary and target. The
+        # fixture's ci rows relabelled as a full run: its failing case must fail the target.
+        with_full = os.path.join(tmp, "with-full")
+        shutil.copytree(full, with_full)
+        stress_full = json.load(open(os.path.join(full, "stress.json")))
+        stress_full["profile"] = "full"
+        for case in stress_full["cases"]:
+            case["ticks"] = max(case.get("ticks", 0), 1000000) if case.get("ticks", 0) > 0 else 0
+        json.dump(stress_full, open(os.path.join(with_full, "stress_full.json"), "w"))
+        md_full = os.path.join(tmp, "with-full.md")
+        result = run(script, with_full, md_full, os.path.join(tmp, "with-full-images"))
+        check(result.returncode == 0, f"report with stress_full.json failed: {result.stderr}")
+        report_full = open(md_full).read()
+        check("### The full profile — `fissure stress --profile full`" in report_full, "no full-profile section")
+        row = target_row(report_full, "full profile passes (every case, ≥ 1e6 rt ticks each)")
+        check(row is not None and row[4] == "**MISSED**", f"full-profile target with a failing case: {row}")
 
         # A benchmark with no JSON: reported, its targets "not checked", never silently gone.
         partial = os.path.join(tmp, "partial")

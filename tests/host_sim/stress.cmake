@@ -9,3 +9,10 @@ if(TARGET fissure)
     WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
   set_tests_properties(app.stress_ci PROPERTIES LABELS "stress" TIMEOUT 300)
 endif()
+# --jobs: cases in child processes give the in-process rows (app/stress_parallel.cpp).
+if(TARGET fissure)
+  add_test(NAME app.stress_parallel
+    COMMAND bash ${CMAKE_SOURCE_DIR}/tests/app/stress_parallel_test.sh $<TARGET_FILE:fissure>
+    WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+  set_tests_properties(app.stress_parallel PROPERTIES LABELS "stress" TIMEOUT 300)
+endif()

@@ -28,9 +28,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from targets import MET, MISSED, NOT_CHECKED, Target, evaluate_all  # noqa: E402
 
-REGENERATE = "build/bin/fissure bench all --out out/bench --docs docs"
+REGENERATE = "build/bin/fissure bench all --out out/bench --docs docs --stress-full"
 
-BENCHMARKS = ["kinematics", "rt", "collision", "proxy", "pareto", "view", "stress"]
+BENCHMARKS = ["kinematics", "rt", "collision", "proxy", "pareto", "view", "stress", "stress_full"]
 # `fissure render` children of bench all: one PNG frame each of the 10 m/s plunge (issue 8).
 PLUNGE_FRAMES = {"plunge_bullet": "plunge-bullet", "plunge_paired": "plunge-paired"}
 
@@ -624,19 +624,24 @@ def section_rt(report, data, problems, targets):
         report.add(targets_table([t for t in targets if t.section == "zwidth"]))
 
 
-def section_stress(report, data, problems, targets):
-    report.add("## Stress summary — `fissure stress --profile ci`")
-    report.add("")
-    stress = data.get("stress")
+def stress_summary(report, name, data, problems, targets):
+    """One stress run's summary: `stress` is the ci profile, `stress_full` the full one (≥ 1e6 rt ticks per case)."""
+    stress = data.get(name)
     if not stress:
-        missing(report, "stress", problems)
+        missing(report, name, problems)
+        if name == "stress_full":
+            report.add("(The full profile runs with `fissure bench all --stress-full`, or alone with "
+                       "`fissure stress --profile full --json stress_full.json`.)")
+            report.add("")
         return
     cases = stress.get("cases", [])
     passed = sum(1 for c in cases if c.get("passed"))
     known = sum(1 for c in cases if not c.get("passed") and c.get("known_failure"))
     failed = sum(1 for c in cases if not c.get("passed") and not c.get("known_failure"))
+    jobs = stress.get("jobs")
     report.add(f"Profile `{stress.get('profile', '?')}`, base seed {stress.get('base_seed', '?')}: {len(cases)} cases — "
-               f"**{passed} passed, {failed} failed, {known} known failures** — in {fmt(stress.get('wall_s'))} s. Checked on "
+               f"**{passed} passed, {failed} failed, {known} known failures** — in {fmt(stress.get('wall_s'))} s"
+               + (f" ({jobs} cases at a time, each in its own process)" if jobs else "") + ". Checked on "
                f"every tick: finite, |F| within the limit, 0 crossed nodes, energy ≤ {fmt(stress.get('energy_bound_j'))} J, only "
                f"injected faults, recovery within {fmt(stress.get('recovery_bound_s'))} s.")
     report.add("")
@@ -654,7 +659,16 @@ def section_stress(report, data, problems, targets):
                      "; ".join(c.get("failures", []))[:160]])
     report.add(table(["case", "group", "outcome", "ticks", "|F| max N", "energy max J", "crossed", "faults seen", "recovered",
                       "failures"], rows))
-    report.add(targets_table([t for t in targets if t.section == "stress"]))
+    report.add(targets_table([t for t in targets if t.section == name]))
+
+
+def section_stress(report, data, problems, targets):
+    report.add("## Stress summary — `fissure stress --profile ci`")
+    report.add("")
+    stress_summary(report, "stress", data, problems, targets)
+    report.add("### The full profile — `fissure stress --profile full`")
+    report.add("")
+    stress_summary(report, "stress_full", data, problems, targets)
 
 
 def section_view(report, data, problems, targets):
