@@ -11,13 +11,27 @@ double slew(double value, double target, double max_step) noexcept {
   return value + std::clamp(target - value, -max_step, max_step);
 }
 
+/// Closes the recovery window's account: its forgiven share joins the total.
+void close_recovery_window(PassivityState& state) noexcept {
+  state.recovery_forgiven_j += std::clamp(state.recovery_window_energy_j, 0.0, kPassivityRecoveryForgiveness_j);
+  state.recovery_window_energy_j = 0.0;
+}
+
+/// What the reduction g does not act on: the closed windows' forgiven work plus the open one's.
+double forgiven_j(const PassivityState& state) noexcept {
+  return state.recovery_forgiven_j + std::clamp(state.recovery_window_energy_j, 0.0, kPassivityRecoveryForgiveness_j);
+}
+
 }  // namespace
 
 void observe_energy(PassivityState& state, const Eigen::Vector3d& p_device_m) noexcept {
   if (state.primed) {
     const double work_j = state.force_acting_device_n.dot(p_device_m - state.p_prev_device_m);
     state.energy_j += work_j;
-    if (state.recovery_window_left_s > 0.0) state.recovery_energy_j += work_j;
+    if (state.recovery_window_left_s > 0.0) {
+      state.recovery_energy_j += work_j;
+      state.recovery_window_energy_j += work_j;
+    }
   }
   state.p_prev_device_m = p_device_m;
   state.primed = true;
@@ -29,7 +43,10 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
                                   const Eigen::Vector3d& force_device_n, const Eigen::Vector3d& v_filtered_m_per_s,
                                   const Eigen::Vector3d& v_raw_m_per_s, double period_s) noexcept {
   state.damping_n_s_per_m = 0.0;
-  state.recovery_window_left_s = std::max(0.0, state.recovery_window_left_s - period_s);
+  if (state.recovery_window_left_s > 0.0) {
+    state.recovery_window_left_s = std::max(0.0, state.recovery_window_left_s - period_s);
+    if (state.recovery_window_left_s <= 0.0) close_recovery_window(state);
+  }
   if (!config.enabled) {
     state.reduction_fraction = 0.0;
     state.reduction_n = 0.0;
@@ -49,8 +66,12 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
     // difference is current but quantised. (Only the decision uses v_raw: it drives ramps,
     // so its noise cannot reach the force as a step.)
     const Eigen::Vector3d total = state.force_sent_last_device_n + force_device_n;
-    const double predicted_j =
-        state.energy_j - state.recovery_energy_j + std::max(total.dot(v_filtered_m_per_s), total.dot(v_raw_m_per_s)) * period_s;
+    // The damper acts on all of E; the reduction g on E less the forgiven recovery work
+    // (kPassivityRecoveryForgiveness_j per fault: a force brought back at a static hold).
+    const double predicted_all_j =
+        state.energy_j + std::max(total.dot(v_filtered_m_per_s), total.dot(v_raw_m_per_s)) * period_s;
+    const double excess_all_j = predicted_all_j + config.margin_j;
+    const double predicted_j = predicted_all_j - forgiven_j(state);
     const double excess_j = predicted_j + config.margin_j;  // above the reference −margin
 
     // g: while the environment returns energy (F̂·v > 0 by the raw difference, which has no
@@ -60,26 +81,52 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
     // stays above the reference and the hand pushes in, hold it (giving the force back now
     // would store energy the environment will return); below the reference give it back.
     const double returning_m_per_s = force_direction.dot(v_raw_m_per_s);  // F̂·v
+    // Power the force returns by the filtered velocity (quantisation-free: ≈ 0 at a hold).
+    const double returned_power_w = std::max(0.0, force_direction.dot(v_filtered_m_per_s)) * force_n;
+    const double budget_j = kPassivityRampEnergyBudgetMargins * config.margin_j;
     double target = 0.0;
     if (excess_j > 0.0) {
-      target = returning_m_per_s > 0.0 && force_n > 0.0
-                   ? std::max(state.reduction_fraction,
-                              std::min(1.0, excess_j / (config.dissipation_time_s * returning_m_per_s * force_n)))
-                   : state.reduction_fraction;
+      if (returning_m_per_s > 0.0 && force_n > 0.0) {
+        // Withhold the excess from what the force returns over dissipation_time_s (a wall
+        // giving back slightly more than it stored)…
+        const double share_for_excess = excess_j / (config.dissipation_time_s * returning_m_per_s * force_n);
+        // …unless the loop has already generated more than the ramp's energy budget: then
+        // the environment is plainly active (a swap offset left from a contact the host has
+        // lost, pushing the hand out at watts) and the push comes off entirely, ramped. Only
+        // withholding the excess, g caught up with a force that keeps pushing at the rate the
+        // excess grew: an overshoot of P·dissipation_time_s (0.2 J at 4 W: the
+        // hc_lambda_over_k_0 stress case, 0.115 J).
+        const double share = predicted_j > budget_j ? 1.0 : share_for_excess;
+        target = std::max(state.reduction_fraction, std::min(1.0, share));
+      } else {
+        target = state.reduction_fraction;
+      }
     }
     // The fraction may change by at most max_correction_step_n of force per tick, steeper in
     // proportion to how much energy has really been created (E' > 0).
     const double urgency =
         std::min(kPassivityMaxUrgency, 1.0 + std::max(0.0, predicted_j) / (kPassivityUrgencyMargins * config.margin_j));
-    const double max_fraction_step =
-        std::min(1.0, config.max_correction_step_n * urgency / std::max(force_n, config.max_correction_step_n));
+    // Energy bound on the ramp itself: while the force pushes the hand out at power
+    // P = F̂·v_f·|F|, taking it off at s newtons per tick returns about ½·P·T·|F|/s before it
+    // is gone; s is at least what keeps that within the budget (kPassivityRampEnergyBudgetMargins
+    // margins). At a hold (v_f of mm/s, a few N) this is far below max_correction_step_n and
+    // changes nothing; a force pushing a hand out at
+    // 0.5 m/s with 8 N (a flick bouncing off the contact, a swap offset left from a contact the
+    // host has already lost) is taken off within a few ticks instead of at 0.05–2 N per tick
+    // while it delivers 4 mJ per tick (hc_lambda_over_k_0 stress case: 0.115 J).
+    // (|F| and P of the whole force, not of the part still acting: a step sized to the
+    // remainder shrinks as it goes and the tail returns the budget again and again.)
+    const double energy_bounded_step_n = excess_j > 0.0 ? returned_power_w * period_s * force_n / (2.0 * budget_j) : 0.0;
+    const double step_n = std::max(config.max_correction_step_n * urgency, energy_bounded_step_n);
+    const double max_fraction_step = std::min(1.0, step_n / std::max(force_n, config.max_correction_step_n));
     state.reduction_fraction = slew(state.reduction_fraction, target, max_fraction_step);
 
     // β: the damping that dissipates the excess within dissipation_time_s at this speed,
     // bounded, ramped.
     const double damping_target =
-        excess_j > 0.0 ? std::min(config.max_damping_n_s_per_m, excess_j / (config.dissipation_time_s * speed * speed))
-                       : 0.0;
+        excess_all_j > 0.0
+            ? std::min(config.max_damping_n_s_per_m, excess_all_j / (config.dissipation_time_s * speed * speed))
+            : 0.0;
     const double damping_step = config.damping_ramp_s > 0.0
                                     ? config.max_damping_n_s_per_m * period_s / config.damping_ramp_s
                                     : config.max_damping_n_s_per_m;
@@ -105,6 +152,7 @@ void record_sent_force(PassivityState& state, const Eigen::Vector3d& force_devic
 }
 
 void restart_observer(PassivityState& state) noexcept {
+  close_recovery_window(state);  // a fault inside a window: that window's account closes here
   state.primed = false;
   state.recovery_window_left_s = kPassivityRecoveryWindow_s;
   state.force_sent_last_device_n.setZero();

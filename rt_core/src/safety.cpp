@@ -38,6 +38,15 @@ void advance_ramp(const SafetyConfig& config, SafetyState& state, bool stop_requ
 
 }  // namespace
 
+Eigen::Vector3d workspace_soft_wall_n(const SafetyConfig& config, const Eigen::Vector3d& p_device_m,
+                                      std::uint32_t& flags) noexcept {
+  const Eigen::Vector3d from_centre = p_device_m - config.workspace_centre_device_m;
+  const double distance = from_centre.norm();
+  if (!(distance > config.workspace_radius_m)) return Eigen::Vector3d::Zero();
+  flags |= kFlagSoftWall;
+  return -config.soft_wall_stiffness_n_per_m * (distance - config.workspace_radius_m) * (from_centre / distance);
+}
+
 Eigen::Vector3d apply_safety(const SafetyConfig& config, SafetyState& state, const SafetyInput& input,
                              double period_s, std::uint32_t& flags) noexcept {
   const bool finite = input.force_device_n.allFinite() && input.p_device_m.allFinite();
@@ -55,12 +64,6 @@ Eigen::Vector3d apply_safety(const SafetyConfig& config, SafetyState& state, con
   }
 
   Eigen::Vector3d force = input.force_device_n;
-  const Eigen::Vector3d from_centre = input.p_device_m - config.workspace_centre_device_m;
-  const double distance = from_centre.norm();
-  if (distance > config.workspace_radius_m) {
-    force -= config.soft_wall_stiffness_n_per_m * (distance - config.workspace_radius_m) * (from_centre / distance);
-    flags |= kFlagSoftWall;
-  }
 
   const double magnitude = force.norm();
   if (magnitude > config.max_force_n) {

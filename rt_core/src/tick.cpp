@@ -133,8 +133,20 @@ TickResult tick(const RtModel& model, RtData& data, TickIo& io, const TickTiming
       }
       begin_swap(data.blend, old_force, new_force);
     }
+    // While a device fault is latched the command is zero and safety brings the force back by
+    // its fault ramp-in, which already keeps the return continuous. A swap offset carried
+    // across the fault would not: the old proxy was built for where the tool was before the
+    // fault, and evaluated where the hand is now (it kept moving while unforced, or the
+    // encoders jumped) it can give tens of newtons no contact produces — which the blend then
+    // renders for up to (offset / blend_max_step_n) ticks after recovery (encoder_jumps stress
+    // case: 25 N walked down over 0.5 s, up to 0.08 J into the hand per fault).
+    if (data.faults.latched_device_faults != 0) data.blend.offset_device_n.setZero();
     data.contact_force_device_n = fade_gain * blend(data.blend, new_force, config.proxy.blend_max_step_n);
-    force = passivity_control(config.passivity, data.passivity, data.contact_force_device_n, data.v_device_m_per_s,
+    // The rendered environment = contact + workspace soft wall; the passivity controller
+    // guards both (safety.hpp: a soft wall ramped in around a hand deep in it returns energy).
+    const Eigen::Vector3d environment_device_n =
+        data.contact_force_device_n + workspace_soft_wall_n(config.safety, data.p_device_m, flags);
+    force = passivity_control(config.passivity, data.passivity, environment_device_n, data.v_device_m_per_s,
                               data.velocity.x1, model.period_s);
     if ((data.passivity.damping_n_s_per_m) > 0.0) flags |= kFlagPassivityActive;
   } else {

@@ -82,12 +82,21 @@ TEST(Safety, SoftWallPushesBackBeyondTheWorkspaceRadius) {
   std::uint32_t flags = 0;
   SafetyInput input;
   input.p_device_m = config.workspace_centre_device_m + Eigen::Vector3d(0.0, 0.0, config.workspace_radius_m + 0.002);
-  const Eigen::Vector3d out = settle(config, state, input, flags);
-  EXPECT_NEAR(out.z(), -config.soft_wall_stiffness_n_per_m * 0.002, 1e-9);
+  const Eigen::Vector3d wall = workspace_soft_wall_n(config, input.p_device_m, flags);
+  EXPECT_NEAR(wall.z(), -config.soft_wall_stiffness_n_per_m * 0.002, 1e-9);
+  EXPECT_EQ(wall.x(), 0.0);
   EXPECT_NE(flags & kFlagSoftWall, 0u);
+  // The tick adds it to the environment force before the passivity controller; apply_safety
+  // itself passes it through like any other force (clamp, ramp, rate limit).
+  input.force_device_n = wall;
+  const Eigen::Vector3d out = settle(config, state, input, flags);
+  EXPECT_NEAR(out.z(), wall.z(), 1e-9);
   flags = 0;
-  input.p_device_m = config.workspace_centre_device_m;
-  EXPECT_EQ(settle(config, state, input, flags), Eigen::Vector3d::Zero());
+  EXPECT_EQ(workspace_soft_wall_n(config, config.workspace_centre_device_m, flags), Eigen::Vector3d::Zero());
+  EXPECT_EQ(flags & kFlagSoftWall, 0u);
+  input.force_device_n.setZero();
+  input.p_device_m = config.workspace_centre_device_m + Eigen::Vector3d(0.0, 0.0, config.workspace_radius_m + 0.01);
+  EXPECT_EQ(settle(config, state, input, flags), Eigen::Vector3d::Zero());  // no wall added here any more
   EXPECT_EQ(flags & kFlagSoftWall, 0u);
 }
 

@@ -214,6 +214,28 @@ TEST(Tick, DeviceTimeoutGivesZeroForceAndRecoversAfterCleanTicks) {
   EXPECT_EQ(h.data.faults.io_errors, 15u);
 }
 
+// A swap while a device fault is latched leaves no offset behind: the force is zero and comes
+// back through safety's ramp-in. Before session 3 the old proxy, evaluated where the hand was
+// after the fault, left its force as a blend offset rendered after recovery with no contact
+// (encoder_jumps stress case: 25 N walked down over 0.5 s).
+TEST(Tick, ProxySwapDuringADeviceFaultLeavesNoOffsetAfterRecovery) {
+  Harness h;
+  h.settle();
+  ASSERT_GT(h.step().force_device_n.y(), 2.0);  // in contact: 2.5 N
+  h.device.status = falcon::IoStatus::kTimeout;
+  for (int i = 0; i < 5; ++i) h.step();
+  h.device.status = falcon::IoStatus::kOk;
+  // The host has meanwhile lost the contact: its plane is 5 cm below the tool.
+  double max_force_n = 0.0;
+  for (int i = 0; i < 600; ++i) {
+    h.publish(kStiffness_n_per_m, -0.05);
+    max_force_n = std::max(max_force_n, h.step().force_device_n.norm());
+  }
+  EXPECT_EQ(max_force_n, 0.0);
+  EXPECT_EQ(h.data.safety.ramp_gain, 1.0);  // recovered
+  EXPECT_EQ(h.data.blend.offset_device_n, Eigen::Vector3d::Zero());
+}
+
 TEST(Tick, DisconnectIsLatchedAtZeroForce) {
   Harness h;
   h.settle();

@@ -33,6 +33,12 @@
 //     below the device's own damping: a virtual damper behind the ping-pong latency and the
 //     filter lag is itself subject to the sampled-data limit b > K·T/2 + |B| (Colgate &
 //     Schenkel 1997).
+// Energy bound on the ramp (session 3): while E' is above the reference and F pushes the hand
+// out at power P (filtered velocity), r heads for at least the share that lets the force
+// return no more than the rest of a 10-margin budget over dissipation_time_s, and moves by at
+// least the step that removes it before ½·P·T·(remaining/step) exceeds that budget. At a
+// hold P ≈ 0 and both are far below the base ramp; a force pushing out at watts is gone in a
+// few ticks (without it the excess only grew until g caught up: P·50 ms, 0.2 J at 4 W).
 // Reference energy −margin: the controller starts before E reaches zero, so it can spread the
 // dissipation over many ticks instead of removing it all in the tick E crosses zero (the
 // chatter of the plain Hannaford–Ryu controller: a 2.3 N step per encoder count at a hold).
@@ -58,6 +64,12 @@ inline constexpr double kPassivityMaxUrgency = 40.0;
 /// Energy scale of the urgency factor, in margins: 1 + E'/(10·margin), i.e. twice as steep
 /// at E' = 4 mJ, 7× at the stress harness's 25 mJ bound.
 inline constexpr double kPassivityUrgencyMargins = 10.0;
+/// Energy the environment may still return while the controller ramps its reduction in, in
+/// margins (4 mJ): the ramp is made steep enough that a force pushing the hand out at power
+/// P is gone before it has returned that much (see passivity.cpp). Ten margins, the scale at
+/// which the urgency factor doubles: small against the stress harness's 25 mJ bound, large
+/// against what a hold returns between two ticks (≲ 10 µJ), so holds keep the 0.05 N ramp.
+inline constexpr double kPassivityRampEnergyBudgetMargins = 10.0;
 /// Time over which the controller aims to dissipate the excess energy [s] (reference-energy
 /// following): 50 ms, a few periods of the hand–device resonance (≈ 7 Hz with a 300 N/m grip)
 /// and of a stiff contact (≈ 20–70 Hz), so the correction stays a small, smooth force.
@@ -68,10 +80,19 @@ inline constexpr double kDefaultPassivityDampingRamp_s = 0.02;
 
 /// After a device fault [s]: the work done while safety brings the force back (its
 /// kDefaultFaultRampIn_s = 0.25 s ramp-in, after FaultConfig's 20 clean ticks ≤ 40 ms at
-/// 500 Hz) is counted in E but attributed to the fault, not to the environment: the ramp
-/// pushes a hand that sank in while the force was off back out, and the controller holding
-/// the contact force down for it would leave the wall soft long after the fault cleared.
+/// 500 Hz) is counted in E and also reported as recovery_energy_j (the ramp pushes a hand
+/// that sank in while the force was off back out). Until session 3 the controller ignored it
+/// (so as not to hold the wall soft after a fault); that let each fault add energy nothing
+/// took back (4.7 J over 999 encoder jumps in the stress harness), so it now counts.
 inline constexpr double kPassivityRecoveryWindow_s = 0.3;
+/// Work done in one fault-recovery window that the force reduction g does not act on [J]:
+/// 10 default margins (4 mJ). Bringing the force back at a static hold necessarily pushes the
+/// hand's spring back out, ½·F²/k ≈ 1.4 mJ for 1.5 N on a 300 N/m hand and a 500 N/m wall;
+/// holding the wall soft for that would leave it soft for as long as the hand holds still (g
+/// does not change at standstill). The damper β still acts on all of E, so the forgiven part is
+/// dissipated as soon as the hand moves; what a recovery returns beyond this (a soft wall or a
+/// contact rendered at a jumped, false position: 26 mJ in 80 ms) is taken off by g as usual.
+inline constexpr double kPassivityRecoveryForgiveness_j = 10.0 * kDefaultPassivityMargin_j;
 
 struct PassivityConfig {
   bool enabled = true;
@@ -102,8 +123,10 @@ struct PassivityState {
   Eigen::Vector3d force_acting_device_n = Eigen::Vector3d::Zero();      ///< computed tick k−2 (acting now)
   Eigen::Vector3d p_prev_device_m = Eigen::Vector3d::Zero();
   bool primed = false;
-  double recovery_energy_j = 0.0;      ///< part of E done in fault-recovery windows (not the environment's)
+  double recovery_energy_j = 0.0;      ///< part of E done in fault-recovery windows (reported; included in E)
   double recovery_window_left_s = 0.0;
+  double recovery_window_energy_j = 0.0;  ///< work done in the current recovery window
+  double recovery_forgiven_j = 0.0;       ///< Σ over closed windows of min(window work, forgiveness)
   double reduction_fraction = 0.0;        ///< g: share of F taken off along F̂ [0, 1]
   double reduction_n = 0.0;               ///< r = g·|F| in the last tick [N]
   double added_damping_n_s_per_m = 0.0;   ///< β
@@ -128,7 +151,8 @@ void record_sent_force(PassivityState& state, const Eigen::Vector3d& force_devic
 /// After a fault the device position history is not trustworthy: restart the Δp chain
 /// (the energy total is kept), drop the correction (the force restarts from zero via
 /// safety's ramp-in anyway) and open a kPassivityRecoveryWindow_s window whose work is
-/// attributed to the fault (recovery_energy_j; the controller acts on E − recovery_energy_j).
+/// reported separately (recovery_energy_j). The damper β acts on the whole E; the reduction g
+/// on E less up to kPassivityRecoveryForgiveness_j of each window's work.
 void restart_observer(PassivityState& state) noexcept;
 
 }  // namespace fissure::rt

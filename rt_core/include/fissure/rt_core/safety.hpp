@@ -1,14 +1,20 @@
 #pragma once
 // Pipeline stage: the one last-line safety function. Whatever the stages before it did,
 // the force that leaves it is finite, within the Falcon's rating, changes no faster than
-// the rate limit, is pushed back towards the workspace by soft walls, and is ramped in at
-// start (and after a device fault) and ramped out at stop. Order inside apply_safety():
+// the rate limit, and is ramped in at start (and after a device fault) and ramped out at
+// stop. Order inside apply_safety():
 //   1. device fault or non-finite input → zero (and the ramp restarts from 0)
-//   2. + workspace soft walls (spring beyond the wall radius, pointing inwards)
-//   3. magnitude clamp to max_force_n, scaling the vector (direction kept)
-//   4. × ramp gain (ramp-in 0→1 over ramp_in_s, ramp-out 1→0 over ramp_out_s)
-//   5. force-rate limit |ΔF| ≤ max_force_rate_n_per_s·T per tick (a fault's zero is exempt:
+//   2. magnitude clamp to max_force_n, scaling the vector (direction kept)
+//   3. × ramp gain (ramp-in 0→1 over ramp_in_s, ramp-out 1→0 over ramp_out_s)
+//   4. force-rate limit |ΔF| ≤ max_force_rate_n_per_s·T per tick (a fault's zero is exempt:
 //      cutting the force is always the safe direction)
+// The workspace soft wall (a spring beyond the wall radius, pointing inwards) is computed
+// here too, but the tick adds it to the contact force BEFORE the passivity controller: it is
+// part of the rendered environment, and like any rendered spring it returns energy it never
+// stored when it is ramped in around a hand that is already deep in it — after an encoder
+// jump to a position 4–9 cm outside the workspace (stress case encoder_jumps: 8 N ramped in,
+// 26 mJ in 80 ms) — which the controller must be able to take back. Until session 3 it was
+// added here, after the controller, where nothing could.
 #include <cstdint>
 
 #include <Eigen/Core>
@@ -73,6 +79,11 @@ struct SafetyInput {
 
 /// Starts (or restarts after a fault) the ramp-in of the given duration.
 void start_ramp_in(SafetyState& state, double ramp_in_s) noexcept;
+
+/// Workspace soft wall at p_device_m [N]: soft_wall_stiffness·(distance − radius) towards
+/// the centre beyond workspace_radius_m, else zero; ORs kFlagSoftWall into `flags` when it acts.
+Eigen::Vector3d workspace_soft_wall_n(const SafetyConfig& config, const Eigen::Vector3d& p_device_m,
+                                      std::uint32_t& flags) noexcept;
 
 /// The last line. Returns the force to command; ORs kFlag*/kFaultNonFinite bits into `flags`.
 Eigen::Vector3d apply_safety(const SafetyConfig& config, SafetyState& state, const SafetyInput& input,
