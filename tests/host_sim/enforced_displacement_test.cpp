@@ -1,0 +1,100 @@
+// Stage 4 of the paired collision (host_sim/src/thin_body/enforced_displacement.cpp): what a
+// HELD soft node does while the tool holds still — the mechanism behind issue 5's "paired → hold
+// jitter ≤ 1 %".
+//  * With ThinBodyCollisionParams::held_node_friction (an option, off by default): a node held on
+//    a tool face sticks to its tool-frame point unless the soft body drags it along the face
+//    harder than Coulomb friction (μ = the soft body's kDF) allows; beyond that it slides by the
+//    excess. (Without it a held node slides freely, and under a held tool the coarse ball can
+//    creep out sideways and the contact set keeps changing.)
+//  * A node lifted off the face moves freely and, pushed back, is held where it lands.
+#include "soft_scene_fixture.hpp"
+
+#include <fissure/host_sim/thin_body_collision.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace fissure::host {
+namespace {
+
+using test_scene::kStep_s;
+
+Eigen::Vector3d to_eigen(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
+
+// A 40 mm plate pressed 2 mm into a frozen flat slab (10 mm cells), then held; the slab node at
+// the centre is under the plate's bottom face, held on it.
+struct HeldSlab {
+  test_scene::SoftWorld world{false};
+  ToolNodes tool;
+  std::unique_ptr<ThinBodyCollision> collision;
+  CollisionStepResult result;
+  ToolPose pose;
+  int centre = -1;
+
+  HeldSlab() : tool(test_scene::plate_tool(0.004)) {
+    world.add_slab(0.1, 10);
+    world.soft().m_cfg.kDF = 0.2f;  // μ between a held node and the tool (the scenes' soft friction)
+    ThinBodyCollisionParams params;
+    params.held_node_friction = true;  // the option under test (off by default)
+    collision = make_paired_collision(tool, world.soft(), params);
+    for (int i = 0; i < world.soft().m_nodes.size(); ++i)
+      if (to_eigen(world.soft().m_nodes[i].m_x).norm() < 1e-6) centre = i;
+    ToolPose previous;
+    previous.position_world_m = Eigen::Vector3d(0, 0.0021, 0);  // bottom face 0.1 mm above the slab
+    for (int s = 1; s <= 10; ++s) {
+      pose = previous;
+      pose.position_world_m.y() = 0.002 - 0.002 * s / 10.0;  // to 2 mm deep
+      world.step_without_dynamics();
+      collision->step(previous, pose, kStep_s, world.soft(), result);
+      previous = pose;
+    }
+  }
+
+  // The soft solver's stand-in: moves the node by `drag` during the step, the tool held still.
+  Eigen::Vector3d hold_step_with_drag(const Eigen::Vector3d& drag_world_m) {
+    world.step_without_dynamics();
+    btSoftBody::Node& node = world.soft().m_nodes[centre];
+    node.m_x += btVector3(static_cast<btScalar>(drag_world_m.x()), static_cast<btScalar>(drag_world_m.y()),
+                          static_cast<btScalar>(drag_world_m.z()));
+    collision->step(pose, pose, kStep_s, world.soft(), result);
+    return to_eigen(world.soft().m_nodes[centre].m_x);
+  }
+};
+
+TEST(EnforcedDisplacement, HeldNodeSticksWithinTheFrictionConeAndSlidesByTheExcess) {
+  HeldSlab slab;
+  ASSERT_GE(slab.centre, 0);
+  const Eigen::Vector3d held = to_eigen(slab.world.soft().m_nodes[slab.centre].m_x);
+  ASSERT_NEAR(held.y(), -0.002, 1e-5) << "the centre node is held on the plate's bottom face";
+  // (The bottom face's outward normal is −y: +y pushes the node into the plate.)
+  // Pushed 1 mm into the face and dragged 0.1 mm along it: 0.1 mm ≤ μ·1 mm = 0.2 mm → it stays.
+  const Eigen::Vector3d after_small = slab.hold_step_with_drag(Eigen::Vector3d(1e-4, 1e-3, 0));
+  EXPECT_NEAR(after_small.x(), held.x(), 1e-7) << "static friction: the held node does not slide";
+  EXPECT_NEAR(after_small.y(), held.y(), 1e-6) << "back on the face";
+  // Pushed 1 mm and dragged 0.5 mm: slides by 0.5 − 0.2 = 0.3 mm (kinetic friction removes μ·push).
+  const Eigen::Vector3d after_large = slab.hold_step_with_drag(Eigen::Vector3d(5e-4, 1e-3, 0));
+  EXPECT_NEAR(after_large.x() - held.x(), 3e-4, 2e-6) << "beyond the cone it slides by the excess";
+  EXPECT_NEAR(after_large.y(), held.y(), 1e-6);
+  // And from its new held point it sticks again.
+  const Eigen::Vector3d after_again = slab.hold_step_with_drag(Eigen::Vector3d(-1e-4, 1e-3, 0));
+  EXPECT_NEAR(after_again.x(), after_large.x(), 1e-7);
+}
+
+TEST(EnforcedDisplacement, HeldNodeLiftedOffMovesFreelyAndIsHeldAgainWhereItLands) {
+  HeldSlab slab;
+  ASSERT_GE(slab.centre, 0);
+  const Eigen::Vector3d held = to_eigen(slab.world.soft().m_nodes[slab.centre].m_x);
+  // Lifted 0.5 mm off the face (and moved 0.3 mm sideways): not put back, still colliding.
+  const Eigen::Vector3d lifted = slab.hold_step_with_drag(Eigen::Vector3d(3e-4, -5e-4, 0));
+  EXPECT_NEAR(lifted.y(), held.y() - 5e-4, 1e-6);
+  EXPECT_NEAR(lifted.x(), held.x() + 3e-4, 1e-6);
+  EXPECT_GT(slab.result.contacted_triangles, 0);
+  // Pushed back into the face: held again where it landed, not snapped back to the old point.
+  const Eigen::Vector3d landed = slab.hold_step_with_drag(Eigen::Vector3d(0, 1e-3, 0));
+  EXPECT_NEAR(landed.x(), held.x() + 3e-4, 1e-6);
+  EXPECT_NEAR(landed.y(), held.y(), 1e-6);
+}
+
+}  // namespace
+}  // namespace fissure::host
