@@ -17,9 +17,14 @@ void close_recovery_window(PassivityState& state) noexcept {
   state.recovery_window_energy_j = 0.0;
 }
 
-/// What the reduction g does not act on: the closed windows' forgiven work plus the open one's.
-double forgiven_j(const PassivityState& state) noexcept {
-  return state.recovery_forgiven_j + std::clamp(state.recovery_window_energy_j, 0.0, kPassivityRecoveryForgiveness_j);
+/// What the reduction g does not act on: the closed windows' forgiven work plus the open one's,
+/// but never more than E stands above the reference −margin — forgiven work that the damper
+/// (or the hand) has since dissipated is no longer owed. (Without this bound the forgiveness
+/// of every past fault added up — 4 mJ × 18 faults — and g stopped acting at all.)
+double forgiven_j(const PassivityState& state, double margin_j) noexcept {
+  const double owed_j =
+      state.recovery_forgiven_j + std::clamp(state.recovery_window_energy_j, 0.0, kPassivityRecoveryForgiveness_j);
+  return std::min(owed_j, std::max(0.0, state.energy_j + margin_j));
 }
 
 }  // namespace
@@ -47,6 +52,8 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
     state.recovery_window_left_s = std::max(0.0, state.recovery_window_left_s - period_s);
     if (state.recovery_window_left_s <= 0.0) close_recovery_window(state);
   }
+  // Forgiven work already dissipated is no longer owed (see forgiven_j).
+  state.recovery_forgiven_j = std::min(state.recovery_forgiven_j, std::max(0.0, state.energy_j + config.margin_j));
   if (!config.enabled) {
     state.reduction_fraction = 0.0;
     state.reduction_n = 0.0;
@@ -71,7 +78,7 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
     const double predicted_all_j =
         state.energy_j + std::max(total.dot(v_filtered_m_per_s), total.dot(v_raw_m_per_s)) * period_s;
     const double excess_all_j = predicted_all_j + config.margin_j;
-    const double predicted_j = predicted_all_j - forgiven_j(state);
+    const double predicted_j = predicted_all_j - forgiven_j(state, config.margin_j);
     const double excess_j = predicted_j + config.margin_j;  // above the reference −margin
 
     // g: while the environment returns energy (F̂·v > 0 by the raw difference, which has no

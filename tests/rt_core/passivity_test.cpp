@@ -247,6 +247,12 @@ TEST(PassivityController, ForgivenessIsBoundedPerFaultWindow) {
   restart_observer(state);
   EXPECT_NEAR(state.recovery_forgiven_j, 3.0 * kPassivityRecoveryForgiveness_j, 1e-15);
   EXPECT_NEAR(state.recovery_energy_j, 3e-2, 1e-15);
+  // Once that energy has been dissipated (E back at the reference) nothing is owed any more:
+  // g acts on later energy in full (the forgiveness of past faults does not pile up).
+  state.energy_j = -PassivityConfig{}.margin_j;
+  passivity_control(PassivityConfig{}, state, Eigen::Vector3d(1.0, 0, 0), Eigen::Vector3d(0.01, 0, 0),
+                    Eigen::Vector3d(0.01, 0, 0), kPeriod_s);
+  EXPECT_EQ(state.recovery_forgiven_j, 0.0);
 }
 
 TEST(PassivityController, RestartDropsTheCorrection) {
