@@ -91,16 +91,36 @@ bool ToolVolume::in_footprint(const Eigen::Vector3d& p_tool) const noexcept {
 }
 
 CrossingTracker::CrossingTracker(ToolVolume volume, int soft_node_count)
-    : volume_(std::move(volume)), side_(static_cast<std::size_t>(soft_node_count), 0) {}
+    : volume_(std::move(volume)),
+      side_(static_cast<std::size_t>(soft_node_count), 0),
+      endpoint_side_(static_cast<std::size_t>(soft_node_count), 0),
+      previous_tool_m_(static_cast<std::size_t>(soft_node_count), Eigen::Vector3d::Zero()) {}
 
 void CrossingTracker::reset(const std::vector<Eigen::Vector3d>& soft_nodes_world_m, const Eigen::Isometry3d& tool_to_world) noexcept {
   const Eigen::Isometry3d world_to_tool = tool_to_world.inverse();
   const std::size_t n = std::min(side_.size(), soft_nodes_world_m.size());
   for (std::size_t i = 0; i < n; ++i) {
-    const double y = (world_to_tool * soft_nodes_world_m[i]).y();
+    previous_tool_m_[i] = world_to_tool * soft_nodes_world_m[i];
+    const double y = previous_tool_m_[i].y();
     side_[i] = y > 0.0 ? 1 : (y < 0.0 ? -1 : 0);
+    endpoint_side_[i] = side_[i];
   }
 }
+
+namespace {
+
+enum class MidPlanePass : std::uint8_t { kNone, kRoundTheRim, kThroughTheTool };
+
+// Where the straight relative path a → b (tool frame) crosses the mid-plane y = 0: outside the
+// tool (round the rim; on a side face counts as outside, as for a node held there) or inside it.
+MidPlanePass mid_plane_pass(const ToolVolume& volume, const Eigen::Vector3d& a, const Eigen::Vector3d& b) noexcept {
+  if (!(a.y() * b.y() < 0.0)) return MidPlanePass::kNone;
+  const double s = a.y() / (a.y() - b.y());
+  const Eigen::Vector3d c = a + s * (b - a);
+  return volume.signed_distance_m(c) < -kInsideToleranceM ? MidPlanePass::kThroughTheTool : MidPlanePass::kRoundTheRim;
+}
+
+}  // namespace
 
 CrossingSnapshot CrossingTracker::update(const std::vector<Eigen::Vector3d>& soft_nodes_world_m, const Eigen::Isometry3d& tool_to_world) noexcept {
   CrossingSnapshot snap;
@@ -118,15 +138,35 @@ CrossingSnapshot CrossingTracker::update(const std::vector<Eigen::Vector3d>& sof
     // leaves it skin_m outside) projects onto the footprint's edge within rounding and may
     // slide past the mid-plane along the face — that is going round the rim, not through.
     const bool beside_rim = !inside && penetration_m == 0.0 && std::abs(p.y()) < volume_.half_thickness_m();
-    if (volume_.in_footprint(p) && !beside_rim) {
+    const bool in_footprint = volume_.in_footprint(p) && !beside_rim;
+    // The previous rule (end point only), kept as a comparison figure.
+    bool endpoint_wrong_side = false;
+    if (in_footprint) {
+      if (endpoint_side_[i] == 0) endpoint_side_[i] = side_now;
+      endpoint_wrong_side = side_now != 0 && side_now != endpoint_side_[i];
+    } else if (side_now != 0) {
+      endpoint_side_[i] = side_now;
+    }
+    snap.endpoint_crossed_nodes += (endpoint_wrong_side || inside) ? 1 : 0;
+    // The path since the last update: round the rim → the memory follows to the new side;
+    // through the tool → crossed, even if the node ended beyond the rim.
+    const MidPlanePass pass = mid_plane_pass(volume_, previous_tool_m_[i], p);
+    previous_tool_m_[i] = p;
+    const bool through = pass == MidPlanePass::kThroughTheTool;
+    if (pass == MidPlanePass::kRoundTheRim && side_now != side_[i]) {
+      side_[i] = side_now;
+      ++snap.rim_passes;
+    }
+    if (in_footprint) {
       if (side_[i] == 0) side_[i] = side_now;  // first seen exactly on the mid-plane
       wrong_side = side_now != 0 && side_now != side_[i];
     } else if (side_now != 0) {
       side_[i] = side_now;  // outside the silhouette a node may go round the rim
     }
     snap.wrong_side_nodes += wrong_side ? 1 : 0;
+    snap.through_nodes += through ? 1 : 0;
     snap.inside_nodes += inside ? 1 : 0;
-    snap.crossed_nodes += (wrong_side || inside) ? 1 : 0;
+    snap.crossed_nodes += (wrong_side || through || inside) ? 1 : 0;
   }
   return snap;
 }

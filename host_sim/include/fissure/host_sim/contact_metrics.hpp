@@ -10,10 +10,22 @@
 //   y_tool). The memory follows the node freely while it is OUTSIDE the footprint (it may
 //   go around the rim); inside the footprint it is frozen — except beside the rim (outside
 //   the tool, |y_tool| < half thickness: a node on a side face), where it also follows.
+//   The memory also follows the PATH between two updates: the node's straight relative path
+//   (tool frame, from where it was at the last update to where it is now — the relative motion
+//   the collision methods sweep) that crosses the mid-plane outside the tool went round the
+//   rim, whatever the end point. Without this, a node the tool's rim passes within one update
+//   (a tool teleport after dropped device replies: the spatula jumped 24 mm sideways in one
+//   1 ms step; a node's relative path crossed the mid-plane 5.1 mm beside its rim) was read as crossed when it ended under
+//   the footprint; and a node that went through the tool and out beyond its rim within one
+//   update was missed.
 // * wrong side: the node is inside the footprint and on the other side of the mid-plane
 //   than it remembers — it went through the tool.
+// * through: the node's relative path since the last update crossed the mid-plane inside the
+//   tool (deeper than kInsideToleranceM) — it went through the tool, wherever it ended.
 // * inside: the node lies inside the tool volume deeper than kInsideToleranceM.
-// * crossed = wrong side OR inside (a node counts once). Target: 0 (issue 5).
+// * crossed = wrong side OR through OR inside (a node counts once). Target: 0 (issue 5).
+// * endpoint_crossed (kept for comparison): the same count with the previous end-point-only
+//   side memory (no path test), which misreads a rim pass within one update as crossed.
 // * penetration: max(0, −signed distance to the tool volume); the max over nodes.
 #include <array>
 #include <cstdint>
@@ -61,6 +73,9 @@ struct CrossingSnapshot {
   int crossed_nodes = 0;       ///< wrong side ∪ inside (see above)
   int wrong_side_nodes = 0;
   int inside_nodes = 0;
+  int through_nodes = 0;            ///< relative path crossed the mid-plane inside the tool since the last update
+  int rim_passes = 0;               ///< changed side by passing the rim (outside the tool) within one update
+  int endpoint_crossed_nodes = 0;   ///< the previous end-point-only rule's crossed count (comparison only)
   double max_penetration_m = 0.0;
 };
 
@@ -82,6 +97,8 @@ class CrossingTracker {
  private:
   ToolVolume volume_;
   std::vector<std::int8_t> side_;
+  std::vector<std::int8_t> endpoint_side_;          // the previous rule's memory (comparison only)
+  std::vector<Eigen::Vector3d> previous_tool_m_;    // each node at the last update, tool frame
 };
 
 }  // namespace fissure::host

@@ -2,8 +2,8 @@
 // HostSimulation: one scene's host side. Owns the Bullet world (SoftWorld), the chosen
 // thin-body collision (one instance per collidable tool part: the spatula, or each clamp
 // jaw), and the method-independent metrics. Each step(): move the tool (and jaws) to the
-// target over the scene's sub-steps, one Bullet step + one collision step per sub-step,
-// then measure. Everything is preallocated at construction; step() does not allocate.
+// target over the scene's sub-steps, one Bullet step + one collision step + the metrics per
+// sub-step (the crossing metric judges each node's straight relative path between two updates). Everything is preallocated at construction; step() does not allocate.
 //
 // Clamp: jaw logic (the one closing DoF) exists only when the scene's tool is a clamp;
 // pairing only for thin tools (ToolNodes::is_thin decides inside the collision).
@@ -37,7 +37,7 @@ struct HostStepResult {
   int part_count = 1;
   std::vector<ContactRecord> contacts;                   ///< all parts (last sub-step); capacity reserved once
   int contact_count = 0;
-  CrossingSnapshot crossing;                             ///< summed over parts; penetration = max
+  CrossingSnapshot crossing;                             ///< summed over parts, the step's worst sub-step (rim passes: all); penetration = max
   std::array<CollisionStepResult, kMaxToolParts> part_results;  ///< the method's own report per part
   HostStepTimes times;
   double jaw_gap_m = 0.0;                                ///< clamp: the gap actually applied
