@@ -179,9 +179,12 @@ TickResult tick(const RtModel& model, RtData& data, TickIo& io, const TickTiming
   // When the encoders were read: the device's receive time if it reports one, else the tick's.
   state.sample_time_ns =
       data.have_position && data.reading.receive_time_ns != 0 ? data.reading.receive_time_ns : now_ns;
-  state.position_device_m = to_vec3(data.kinematics.p_device_m);
+  // The last good sample, never the FK stage's own state: after a failed solve that holds the
+  // non-converged iterate (a cold start from the workspace centre), and the host would move its
+  // tool there — through the soft body — for as long as the fault lasts.
+  state.position_device_m = to_vec3(data.p_device_m);
   state.velocity_device_m_per_s = to_vec3(data.v_device_m_per_s);
-  state.closing_axis_m = jaw_closing_m(config.mapping, data.kinematics.p_device_m);
+  state.closing_axis_m = jaw_closing_m(config.mapping, data.p_device_m);
   state.buttons = data.reading.buttons;
   state.status_flags = to_device_status(data, flags);
   io.state_out.publish(state);

@@ -284,6 +284,28 @@ TEST(Tick, KinematicsFailureIsANonFiniteFaultWithZeroForce) {
   expect_device_fault_recovery(h, kFaultEncoderJump);
 }
 
+TEST(Tick, DeviceStateDuringAKinematicsFailureKeepsTheLastGoodPosition) {
+  // The host moves its tool to the published position: a failed solve's iterate (the cold
+  // start's workspace centre) would teleport the tool through the soft body.
+  const Eigen::Vector3d p_off_centre_device_m(0.012, -0.008, 0.110);
+  Harness h(RtConfig{}, p_off_centre_device_m);
+  h.settle();
+  const Eigen::Vector3d last_good_device_m = h.data.p_device_m;
+  ASSERT_GT((last_good_device_m - kCentre_device_m).norm(), 0.01);
+  h.device.counts = {10000, 10000, 10000};  // first an encoder jump, then judged against it: FK fails
+  bool solve_failed = false;
+  for (int i = 0; i < 5; ++i) {
+    h.publish(kStiffness_n_per_m);
+    const TickResult result = h.step();
+    solve_failed = solve_failed || (result.fault_bits & kFaultNonFinite) != 0u;
+    DeviceState state;
+    ASSERT_TRUE(h.state_out.try_fetch(state));
+    EXPECT_NE(state.status_flags & fissure::kDeviceFaultMask, 0u);
+    for (int axis = 0; axis < 3; ++axis) EXPECT_EQ(state.position_device_m[axis], last_good_device_m[axis]) << "axis " << axis;
+  }
+  EXPECT_TRUE(solve_failed);
+}
+
 TEST(Tick, StopRampsOutToZero) {
   Harness h;
   h.settle();
