@@ -85,6 +85,9 @@ struct StressSetup {
   /// The set-up must be refused with a clear error (e.g. a degenerate tool mesh): the case
   /// passes when constructing the session throws, and fails if it runs.
   bool expect_rejection = false;
+  /// Fraction of rt ticks the tool must render contact in: a case about a contact (the clamp
+  /// squeezing the sphere flat) proves nothing once the body has slipped away from the tool.
+  double min_contact_fraction = 0.0;
   std::string note;
 };
 
@@ -128,6 +131,8 @@ struct StressRow {
   std::uint64_t recoveries_required = 0;
   std::uint64_t recoveries_done = 0;
   double recovery_max_s = 0.0;
+  std::uint64_t contact_ticks = 0;      ///< rt ticks that rendered at least one contact patch
+  double min_contact_fraction = 0.0;    ///< what the case requires of contact_ticks / ticks
   double wall_s = 0.0;
   std::string note;
 };

@@ -51,8 +51,8 @@ nlohmann::json machine_json() {
 }
 
 void print_header() {
-  std::printf("%-28s %-20s %9s %-5s %6s %9s %4s %-27s %13s %9s %6s\n", "case", "seed", "ticks", "ok", "|F|max",
-              "E max [J]", "xing", "faults seen", "inj/onsets", "recovered", "wall");
+  std::printf("%-28s %-20s %9s %-5s %6s %9s %4s %8s %-27s %13s %9s %6s\n", "case", "seed", "ticks", "ok", "|F|max",
+              "E max [J]", "xing", "contact%", "faults seen", "inj/onsets", "recovered", "wall");
 }
 
 void print_row(const StressRow& r) {
@@ -62,10 +62,11 @@ void print_row(const StressRow& r) {
   char injected[40];
   std::snprintf(injected, sizeof injected, "%llu/%llu", static_cast<unsigned long long>(r.injected_events),
                 static_cast<unsigned long long>(r.fault_onsets));
-  std::printf("%-28s %-20llu %9llu %-5s %6.2f %9.2e %4d %-27s %13s %9s %5.1fs\n", r.name.c_str(),
+  const double contact_percent = r.ticks > 0 ? 100.0 * static_cast<double>(r.contact_ticks) / static_cast<double>(r.ticks) : 0.0;
+  std::printf("%-28s %-20llu %9llu %-5s %6.2f %9.2e %4d %8.1f %-27s %13s %9s %5.1fs\n", r.name.c_str(),
               static_cast<unsigned long long>(r.seed), static_cast<unsigned long long>(r.ticks), r.passed ? "pass" : (r.known_failure ? "KNOWN" : "FAIL"),
-              r.force_max_n, r.energy_max_j, r.crossed_nodes_max, fault_bits_text(r.fault_bits_seen).c_str(), injected, recovered,
-              r.wall_s);
+              r.force_max_n, r.energy_max_j, r.crossed_nodes_max, contact_percent, fault_bits_text(r.fault_bits_seen).c_str(), injected,
+              recovered, r.wall_s);
   if (!r.note.empty()) std::printf("    note: %s\n", r.note.c_str());
   for (const std::string& f : r.failures) std::printf("    FAIL: %s\n", f.c_str());
   std::fflush(stdout);

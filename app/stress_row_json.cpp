@@ -28,6 +28,9 @@ nlohmann::json stress_row_to_json(const StressRow& r) {
           {"recoveries_required", r.recoveries_required},
           {"recoveries_done", r.recoveries_done},
           {"recovery_max_s", r.recovery_max_s},
+          {"contact_ticks", r.contact_ticks},
+          {"contact_fraction", r.ticks > 0 ? static_cast<double>(r.contact_ticks) / static_cast<double>(r.ticks) : 0.0},
+          {"min_contact_fraction", r.min_contact_fraction},
           {"wall_s", r.wall_s},
           {"note", r.note}};
 }
@@ -56,6 +59,8 @@ StressRow stress_row_from_json(const nlohmann::json& j) {
   j.at("recoveries_required").get_to(r.recoveries_required);
   j.at("recoveries_done").get_to(r.recoveries_done);
   j.at("recovery_max_s").get_to(r.recovery_max_s);
+  j.at("contact_ticks").get_to(r.contact_ticks);
+  j.at("min_contact_fraction").get_to(r.min_contact_fraction);
   j.at("wall_s").get_to(r.wall_s);
   j.at("note").get_to(r.note);
   return r;

@@ -653,12 +653,14 @@ def stress_summary(report, name, data, problems, targets):
     rows = []
     for c in cases:
         outcome = "pass" if c.get("passed") else ("KNOWN" if c.get("known_failure") else "**FAIL**")
+        contact = c.get("contact_fraction")
         rows.append([c.get("name"), c.get("group"), outcome, fmt(c.get("ticks")), fmt(c.get("force_max_n")),
-                     fmt(c.get("energy_max_j")), fmt(c.get("crossed_nodes_max")), c.get("faults_seen", ""),
+                     fmt(c.get("energy_max_j")), fmt(c.get("crossed_nodes_max")),
+                     "—" if contact is None else f"{100 * contact:.0f}", c.get("faults_seen", ""),
                      f"{c.get('recoveries_done', 0)}/{c.get('recoveries_required', 0)}",
                      "; ".join(c.get("failures", []))[:160]])
-    report.add(table(["case", "group", "outcome", "ticks", "|F| max N", "energy max J", "crossed", "faults seen", "recovered",
-                      "failures"], rows))
+    report.add(table(["case", "group", "outcome", "ticks", "|F| max N", "energy max J", "crossed", "contact %", "faults seen",
+                      "recovered", "failures"], rows))
     report.add(targets_table([t for t in targets if t.section == name]))
 
 
