@@ -232,12 +232,21 @@ def collision_targets(col):
     if len(paired_contact) >= 2:
         small, large = paired_contact[0], paired_contact[-1]
         growth = large["collision_median_us"] / small["collision_median_us"]
+        # Judged on the spread over every mesh, not only the two ends: the 128-face ball needs a
+        # deep press for the same triangle count, which puts ~40× the tool area in contact
+        # (session 3 measurement), so its row is dear and an end-to-end ratio hides growth
+        # with the mesh between the finer meshes.
+        cheapest = min(paired_contact, key=lambda r: r["collision_median_us"])
+        dearest = max(paired_contact, key=lambda r: r["collision_median_us"])
+        spread = dearest["collision_median_us"] / cheapest["collision_median_us"]
         text = (f"{_f(small['collision_median_us'])} µs at {small['faces']} → {_f(large['collision_median_us'])} µs at "
-                f"{large['faces']} faces ({in_case.replace('_', ' ')}): {growth:.2f}×")
+                f"{large['faces']} faces ({in_case.replace('_', ' ')}): {growth:.2f}×; over all meshes "
+                f"{_f(cheapest['collision_median_us'])} µs at {cheapest['faces']} → {_f(dearest['collision_median_us'])} µs at "
+                f"{dearest['faces']} faces: {spread:.2f}×")
         per_tri = (col.get("scaling_summary") or {}).get("same_press_per_triangle_ratio_fine_over_coarse")
         if per_tri is not None:
             text += f"; per contacted triangle at the same press {per_tri:.2f}×"
-        out.append(Target("collision scaling", scale_d[2], text, _status(growth <= 2.0), COL_SOURCE))
+        out.append(Target("collision scaling", scale_d[2], text, _status(max(growth, spread) <= 2.0), COL_SOURCE))
     else:
         out.append(Target("collision scaling", scale_d[2], "fewer than two paired meshes", NOT_CHECKED, COL_SOURCE))
     return out
