@@ -120,6 +120,18 @@ MidPlanePass mid_plane_pass(const ToolVolume& volume, const Eigen::Vector3d& a, 
   return volume.signed_distance_m(c) < -kInsideToleranceM ? MidPlanePass::kThroughTheTool : MidPlanePass::kRoundTheRim;
 }
 
+// The end-point side memory: inside the footprint it is frozen and a node on the other side
+// of the mid-plane went through (returns true); outside it follows the node (it may go round
+// the rim). A node first seen exactly on the mid-plane takes the side it is next seen on.
+bool follow_side(std::int8_t& memory, std::int8_t side_now, bool in_footprint) noexcept {
+  if (!in_footprint) {
+    if (side_now != 0) memory = side_now;
+    return false;
+  }
+  if (memory == 0) memory = side_now;
+  return side_now != 0 && side_now != memory;
+}
+
 }  // namespace
 
 CrossingSnapshot CrossingTracker::update(const std::vector<Eigen::Vector3d>& soft_nodes_world_m, const Eigen::Isometry3d& tool_to_world) noexcept {
@@ -132,7 +144,6 @@ CrossingSnapshot CrossingTracker::update(const std::vector<Eigen::Vector3d>& sof
     const double penetration_m = std::max(0.0, -volume_.signed_distance_m(p));
     snap.max_penetration_m = std::max(snap.max_penetration_m, penetration_m);
     const bool inside = penetration_m > kInsideToleranceM;
-    bool wrong_side = false;
     // Beside the rim: outside the tool but within its thickness band. The footprint's edge and
     // the tool's side face are the same line, so a node held on a side face (the paired method
     // leaves it skin_m outside) projects onto the footprint's edge within rounding and may
@@ -140,13 +151,7 @@ CrossingSnapshot CrossingTracker::update(const std::vector<Eigen::Vector3d>& sof
     const bool beside_rim = !inside && penetration_m == 0.0 && std::abs(p.y()) < volume_.half_thickness_m();
     const bool in_footprint = volume_.in_footprint(p) && !beside_rim;
     // The previous rule (end point only), kept as a comparison figure.
-    bool endpoint_wrong_side = false;
-    if (in_footprint) {
-      if (endpoint_side_[i] == 0) endpoint_side_[i] = side_now;
-      endpoint_wrong_side = side_now != 0 && side_now != endpoint_side_[i];
-    } else if (side_now != 0) {
-      endpoint_side_[i] = side_now;
-    }
+    const bool endpoint_wrong_side = follow_side(endpoint_side_[i], side_now, in_footprint);
     snap.endpoint_crossed_nodes += (endpoint_wrong_side || inside) ? 1 : 0;
     // The path since the last update: round the rim → the memory follows to the new side;
     // through the tool → crossed, even if the node ended beyond the rim.
@@ -157,12 +162,7 @@ CrossingSnapshot CrossingTracker::update(const std::vector<Eigen::Vector3d>& sof
       side_[i] = side_now;
       ++snap.rim_passes;
     }
-    if (in_footprint) {
-      if (side_[i] == 0) side_[i] = side_now;  // first seen exactly on the mid-plane
-      wrong_side = side_now != 0 && side_now != side_[i];
-    } else if (side_now != 0) {
-      side_[i] = side_now;  // outside the silhouette a node may go round the rim
-    }
+    const bool wrong_side = follow_side(side_[i], side_now, in_footprint);
     snap.wrong_side_nodes += wrong_side ? 1 : 0;
     snap.through_nodes += through ? 1 : 0;
     snap.inside_nodes += inside ? 1 : 0;

@@ -140,7 +140,7 @@ TickResult tick(const RtModel& model, RtData& data, TickIo& io, const TickTiming
     // encoders jumped) it can give tens of newtons no contact produces — which the blend then
     // renders for up to (offset / blend_max_step_n) ticks after recovery (encoder_jumps stress
     // case: 25 N walked down over 0.5 s, up to 0.08 J into the hand per fault).
-    if (data.faults.latched_device_faults != 0) data.blend.offset_device_n.setZero();
+    if (data.faults.latched_device_faults != 0) cancel_swaps(data.blend);
     data.contact_force_device_n = fade_gain * blend(data.blend, new_force, config.proxy.blend_max_step_n);
     // The rendered environment = contact + workspace soft wall; the passivity controller
     // guards both (safety.hpp: a soft wall ramped in around a hand deep in it returns energy).

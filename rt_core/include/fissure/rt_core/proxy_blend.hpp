@@ -19,6 +19,11 @@ struct BlendState {
 void begin_swap(BlendState& state, const Eigen::Vector3d& old_force_device_n,
                 const Eigen::Vector3d& new_force_device_n) noexcept;
 
+/// Drops what is left of the swap offsets: the force they stood for no longer applies (the
+/// old proxies were built for a tool pose lost in a device fault; the tick calls this while
+/// one is latched and safety's ramp-in brings the force back continuously instead).
+inline void cancel_swaps(BlendState& state) noexcept { state.offset_device_n.setZero(); }
+
 /// Walks the offset ≤ max_step_n towards zero, then returns new_force + offset.
 Eigen::Vector3d blend(BlendState& state, const Eigen::Vector3d& new_force_device_n, double max_step_n) noexcept;
 
