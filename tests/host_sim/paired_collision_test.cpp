@@ -610,3 +610,57 @@ TEST(PairedCollision, RejectsAnotherSoftBodyAndBadParameters) {
 
 }  // namespace
 }  // namespace fissure::host
+
+namespace fissure::host {
+namespace {
+
+// HuntCrossleyParams::rest_frame: a plate pressed quasi-statically 3 mm below the top of the
+// paper's sphere, once as built and once after the whole ball was lifted rigidly by 5 mm along
+// the plate's normal (the same shape, 5 mm higher). pose_matched carries the rest shape with
+// Bullet's pose-matching frame, so the same relative press gives the same force; world keeps the
+// rest positions where they were, so the lifted ball reads 5 mm less indentation.
+double force_after_rigid_lift(RestFrame rest_frame, double lift_m) {
+  test_scene::SoftWorld world(false);
+  world.add_sphere();
+  const ToolNodes tool = test_scene::plate_tool(0.002);
+  ThinBodyCollisionParams params;
+  params.hunt_crossley.rest_frame = rest_frame;
+  params.hunt_crossley.lambda = 0.0;  // elastic term only: the press is quasi-static
+  auto collision = make_paired_collision(tool, world.soft(), params);  // rest state: the ball as built
+  btSoftBody& soft = world.soft();
+  double top_m = -1.0;
+  for (int i = 0; i < soft.m_nodes.size(); ++i) {
+    soft.m_nodes[i].m_x += btVector3(0, static_cast<btScalar>(lift_m), 0);
+    top_m = std::max(top_m, static_cast<double>(soft.m_nodes[i].m_x.y()));
+  }
+  soft.updatePose();  // the pose-matching frame follows the lifted body (Bullet does this every step)
+  CollisionStepResult result;
+  ToolPose previous;
+  previous.position_world_m = Eigen::Vector3d(0.0, top_m + 0.0011, 0.0);  // bottom face 0.1 mm above the top
+  constexpr double kDepthM = 0.003;
+  constexpr int kSteps = 40;
+  for (int s = 1; s <= kSteps; ++s) {
+    ToolPose current = previous;
+    current.position_world_m.y() = top_m + 0.0011 - (0.0001 + kDepthM) * s / kSteps;
+    world.step_without_dynamics();
+    collision->step(previous, current, kStep_s, soft, result);
+    previous = current;
+  }
+  return result.force_on_tool_world_n.y();
+}
+
+TEST(PairedCollision, PoseMatchedRestFrameFollowsTheBodyAndTheWorldFrameDoesNot) {
+  const double pose_flat = force_after_rigid_lift(RestFrame::kPoseMatched, 0.0);
+  const double pose_lifted = force_after_rigid_lift(RestFrame::kPoseMatched, 0.005);
+  const double world_flat = force_after_rigid_lift(RestFrame::kWorld, 0.0);
+  const double world_lifted = force_after_rigid_lift(RestFrame::kWorld, 0.005);
+  std::printf("[paired] 3 mm press, ball lifted 0 / 5 mm: pose_matched %.4f / %.4f N, world %.4f / %.4f N\n", pose_flat, pose_lifted,
+              world_flat, world_lifted);
+  ASSERT_GT(pose_flat, 0.01) << "the plate must press the ball";
+  EXPECT_NEAR(pose_lifted / pose_flat, 1.0, 1e-3);
+  EXPECT_NEAR(world_flat / pose_flat, 1.0, 1e-3) << "at rest both frames agree";
+  EXPECT_LT(world_lifted, 0.5 * world_flat) << "world rest positions read the lift as 5 mm less indentation";
+}
+
+}  // namespace
+}  // namespace fissure::host
