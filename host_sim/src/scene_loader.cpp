@@ -16,10 +16,12 @@
 #include <sstream>
 #include <utility>
 
+#include <Eigen/Geometry>
 #include <tiny_obj_loader.h>
 
 #include <toml++/toml.h>
 
+#include "fissure/host_sim/soft_body_builder.hpp"
 #include "fissure/host_sim/tool_mesh_io.hpp"
 
 namespace fissure::host {
@@ -275,7 +277,41 @@ void read_ground(TableReader& t, GroundDescription& ground) {
   t.finish();
 }
 
-void read_soft_body(TableReader& t, SoftBodyDescription& soft) {
+// [[soft_body.anchor]]: world boxes; each must select at least one node of the rest mesh
+// (an empty box is a typo in a coordinate, not a wish for no anchor).
+void read_anchors(const std::string& file, TableReader& t, SoftBodyDescription& soft) {
+  const toml::array* boxes = t.array_of_tables("anchor");
+  if (boxes == nullptr) return;
+  std::vector<int> lines;
+  for (std::size_t i = 0; i < boxes->size(); ++i) {
+    const toml::table& table = *boxes->get(i)->as_table();
+    TableReader a(file, table, child_path(t, "anchor[" + std::to_string(i) + "]"));
+    SoftAnchorBox box;
+    box.min_world_m = a.vec3("min_world", "m");
+    box.max_world_m = a.vec3("max_world", "m");
+    for (std::size_t k = 0; k < 3; ++k) {
+      if (box.min_world_m[k] > box.max_world_m[k]) {
+        a.fail(a.line_for("max_world", "m"), "max_world_m", "must be >= min_world_m in every axis (axis " + std::to_string(k) + ")");
+      }
+    }
+    a.finish();
+    soft.anchors.push_back(box);
+    lines.push_back(a.table_line());
+  }
+  const std::vector<Vec3> rest = soft_body_rest_nodes_world_m(soft);
+  for (std::size_t i = 0; i < soft.anchors.size(); ++i) {
+    if (!nodes_in_anchor_box(rest, soft.anchors[i]).empty()) continue;
+    Eigen::AlignedBox3d bounds;
+    for (const Vec3& v : rest) bounds.extend(Eigen::Vector3d(v[0], v[1], v[2]));
+    std::ostringstream msg;
+    msg << "the box selects no soft node (the rest mesh's " << rest.size() << " nodes span [" << bounds.min().x() << ", "
+        << bounds.min().y() << ", " << bounds.min().z() << "] .. [" << bounds.max().x() << ", " << bounds.max().y() << ", "
+        << bounds.max().z() << "] m)";
+    throw SceneError(file, lines[i], child_path(t, "anchor[" + std::to_string(i) + "]"), msg.str());
+  }
+}
+
+void read_soft_body(const std::string& file, TableReader& t, SoftBodyDescription& soft) {
   const std::string shape = t.text("shape");
   if (shape == "sphere") {
     SoftSphere s;
@@ -323,6 +359,7 @@ void read_soft_body(TableReader& t, SoftBodyDescription& soft) {
   soft.friction_ratio = t.in_range("friction", "ratio", 0.0, 1.0);
   soft.position_iterations_count = t.count("position_iterations", 1, 1000);
   soft.collision_margin_m = t.in_range("collision_margin", "m", 0.0, 0.1);
+  read_anchors(file, t, soft);
   t.finish();
 }
 
@@ -509,7 +546,7 @@ SceneDescription parse(const toml::table& root, const std::string& file, const s
   }
   {
     TableReader t(file, *top.subtable("soft_body", true), "soft_body");
-    read_soft_body(t, scene.soft_body);
+    read_soft_body(file, t, scene.soft_body);
   }
   {
     TableReader t(file, *top.subtable("tool", true), "tool");

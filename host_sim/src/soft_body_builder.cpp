@@ -3,10 +3,12 @@
 
 #include <cmath>
 #include <map>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <utility>
 
+#include <BulletDynamics/Dynamics/btRigidBody.h>
 #include <BulletSoftBody/btSoftBody.h>
 #include <BulletSoftBody/btSoftBodyHelpers.h>
 #include <Eigen/Core>
@@ -192,6 +194,57 @@ btSoftBody* build_soft_body(btSoftBodyWorldInfo& world_info, const SoftBodyDescr
     body->setPose(d.volume_conservation_kvc > 0.0, d.shape_matching_ratio > 0.0);
   body->setActivationState(DISABLE_DEACTIVATION);
   return body;
+}
+
+std::vector<Vec3> soft_body_rest_nodes_world_m(const SoftBodyDescription& description) {
+  // The same construction as the world's body, in a throw-away world info (the meshes never
+  // touch its broadphase or SDF), so the selection is exactly the nodes the world will have.
+  btSoftBodyWorldInfo info;
+  const std::unique_ptr<btSoftBody> body(build_soft_body(info, description));
+  std::vector<Vec3> nodes;
+  nodes.reserve(static_cast<std::size_t>(body->m_nodes.size()));
+  for (int i = 0; i < body->m_nodes.size(); ++i) {
+    const btVector3& x = body->m_nodes[i].m_x;
+    nodes.push_back({x.x(), x.y(), x.z()});
+  }
+  return nodes;
+}
+
+std::vector<int> nodes_in_anchor_box(const std::vector<Vec3>& nodes_world_m, const SoftAnchorBox& box) {
+  std::vector<int> inside;
+  for (std::size_t i = 0; i < nodes_world_m.size(); ++i) {
+    bool in = true;
+    for (std::size_t a = 0; a < 3; ++a) in = in && nodes_world_m[i][a] >= box.min_world_m[a] && nodes_world_m[i][a] <= box.max_world_m[a];
+    if (in) inside.push_back(static_cast<int>(i));
+  }
+  return inside;
+}
+
+int anchor_soft_body(btSoftBody& body, btRigidBody& bed, const SoftBodyDescription& description) {
+  if (description.anchors.empty()) return 0;
+  std::vector<Vec3> nodes;
+  nodes.reserve(static_cast<std::size_t>(body.m_nodes.size()));
+  for (int i = 0; i < body.m_nodes.size(); ++i) {
+    const btVector3& x = body.m_nodes[i].m_x;
+    nodes.push_back({x.x(), x.y(), x.z()});
+  }
+  std::vector<bool> anchored(nodes.size(), false);
+  int count = 0;
+  for (std::size_t b = 0; b < description.anchors.size(); ++b) {
+    const std::vector<int> selected = nodes_in_anchor_box(nodes, description.anchors[b]);
+    if (selected.empty()) throw std::invalid_argument("soft_body.anchor[" + std::to_string(b) + "] selects no soft node");
+    for (const int i : selected) {
+      if (anchored[static_cast<std::size_t>(i)]) continue;  // overlapping boxes: one anchor per node
+      anchored[static_cast<std::size_t>(i)] = true;
+      // disableCollisionBetweenLinkedBodies = false: that flag would switch off the contact of
+      // EVERY node with the bed (btSoftBody::m_collisionDisabledObjects is per body), and the
+      // free nodes must still land on it. Influence 1: the full anchor impulse (the anchor's
+      // stiffness is Bullet's kAHR, default 0.7 of the offset per solver pass).
+      body.appendAnchor(i, &bed, false, 1);
+      ++count;
+    }
+  }
+  return count;
 }
 
 }  // namespace fissure::host

@@ -178,6 +178,18 @@ SoftWorld::SoftWorld(const SceneDescription& scene, bool tool_collides_in_bullet
   }
 
   soft_.reset(build_soft_body(info, scene.soft_body));
+  // [[soft_body.anchor]]: tie the selected rest nodes to the ground (the bed the tissue lies on).
+  try {
+    anchored_nodes_count_ = anchor_soft_body(*soft_, *ground_, scene.soft_body);
+  } catch (...) {
+    // The destructor does not run for a half-built world: take the bodies out of it here, or
+    // the world's own destructor would touch their freed broadphase proxies.
+    for (int p = 0; p < geometry_.part_count; ++p) {
+      if (parts_in_world_) world_->removeRigidBody(parts_[static_cast<std::size_t>(p)].get());
+    }
+    world_->removeRigidBody(ground_.get());
+    throw;
+  }
   world_->addSoftBody(soft_.get());
   if (probe_ != nullptr) {
     std::array<const btCollisionObject*, kMaxToolParts> objects{};

@@ -152,6 +152,40 @@ TEST(SceneLoader, ShapeMatchingIsOptionalAndRangeChecked) {
   expect_error(load_error(bad), line_of(bad, "shape_matching_ratio"), "soft_body.shape_matching_ratio", "must be in");
 }
 
+// [[soft_body.anchor]] goes right after the [soft_body] table (before [tool]).
+std::string with_anchor(const std::string& shipped, const std::string& anchor_body) {
+  return replace(shipped, "\n[tool]\n", "\n[[soft_body.anchor]]\n" + anchor_body + "\n\n[tool]\n");
+}
+
+TEST(SceneLoader, AnchorsAreOptionalAndRead) {
+  const std::string shipped = read(kScenes / "spatula-sphere.toml");
+  EXPECT_TRUE(load_scene_text(shipped, "good.toml", kScenes).soft_body.anchors.empty());
+  const std::string good = with_anchor(shipped, "min_world_m = [-0.1, -0.01, -0.1]\nmax_world_m = [0.1, 0.012, 0.1]");
+  const SceneDescription scene = load_scene_text(good, "good.toml", kScenes);
+  ASSERT_EQ(scene.soft_body.anchors.size(), 1u);
+  EXPECT_EQ(scene.soft_body.anchors[0].min_world_m[1], -0.01);
+  EXPECT_EQ(scene.soft_body.anchors[0].max_world_m[1], 0.012);
+}
+
+TEST(SceneLoader, MalformedAnchorsNameFileLineAndField) {
+  const std::string shipped = read(kScenes / "spatula-sphere.toml");
+  const std::string unknown = with_anchor(shipped, "min_world_m = [-0.1, -0.01, -0.1]\nmax_world_m = [0.1, 0.012, 0.1]\nnode = 3");
+  expect_error(load_error(unknown), line_of(unknown, "node = 3"), "soft_body.anchor[0].node", "unknown key");
+  const std::string unit = with_anchor(shipped, "min_world_mm = [-100, -10, -100]\nmax_world_m = [0.1, 0.012, 0.1]");
+  expect_error(load_error(unit), line_of(unit, "min_world_mm"), "soft_body.anchor[0].min_world_mm", "wrong unit");
+  const std::string missing = with_anchor(shipped, "min_world_m = [-0.1, -0.01, -0.1]");
+  expect_error(load_error(missing), line_of(missing, "[[soft_body.anchor]]"), "soft_body.anchor[0].max_world_m", "missing field");
+  const std::string short_vec = with_anchor(shipped, "min_world_m = [-0.1, -0.01]\nmax_world_m = [0.1, 0.012, 0.1]");
+  expect_error(load_error(short_vec), line_of(short_vec, "min_world_m"), "soft_body.anchor[0].min_world_m", "array of 3 numbers");
+  const std::string inverted = with_anchor(shipped, "min_world_m = [-0.1, 0.02, -0.1]\nmax_world_m = [0.1, 0.012, 0.1]");
+  expect_error(load_error(inverted), line_of(inverted, "max_world_m"), "soft_body.anchor[0].max_world_m", "must be >= min_world_m");
+  // A box beside the ball (above it: the top is at y = 0.102) selects no node: a typo, refused.
+  const std::string empty = with_anchor(shipped, "min_world_m = [-0.1, 0.2, -0.1]\nmax_world_m = [0.1, 0.3, 0.1]");
+  expect_error(load_error(empty), line_of(empty, "[[soft_body.anchor]]"), "soft_body.anchor[0]", "selects no soft node");
+  const std::string not_table = replace(shipped, "collision_margin_m = 0.002", "collision_margin_m = 0.002\nanchor = 1");
+  expect_error(load_error(not_table), line_of(not_table, "anchor = 1"), "soft_body.anchor", "array of tables");
+}
+
 TEST(SceneLoader, DeformationMeasureIsOptionalAndChecked) {
   const std::string good = read(kScenes / "spatula-sphere.toml");
   EXPECT_EQ(load_scene_text(good, "good.toml", kScenes).hunt_crossley.deformation_measure, DeformationMeasureKind::kNormalDisplacement);

@@ -58,6 +58,15 @@ struct SoftSlab {
   std::array<int, 2> top_cells_count{16, 16};  ///< grid cells of the top face along x, z
 };
 
+/// Soft-body anchoring (tissue attached to its bed): every node whose REST position (the
+/// shape as built, before settling) lies in this world box, bounds included, is tied to the
+/// ground by a Bullet anchor (btSoftBody::appendAnchor). Anchored nodes keep their mass, so
+/// the thin-body collision still moves them and Bullet pulls them back to where they were.
+struct SoftAnchorBox {
+  Vec3 min_world_m{0.0, 0.0, 0.0};
+  Vec3 max_world_m{0.0, 0.0, 0.0};
+};
+
 struct SoftBodyDescription {
   std::variant<SoftSphere, SoftCylinder, SoftSlab> shape{SoftSphere{}};
   double mass_kg = 0.1;
@@ -71,6 +80,7 @@ struct SoftBodyDescription {
   double friction_ratio = 0.2;             ///< Bullet config kDF ∈ [0, 1]
   int position_iterations_count = 4;       ///< Bullet config piterations
   double collision_margin_m = 0.002;       ///< soft body collision margin (bullet method)
+  std::vector<SoftAnchorBox> anchors;      ///< [[soft_body.anchor]]; none by default (a free body)
 };
 
 struct GroundDescription {

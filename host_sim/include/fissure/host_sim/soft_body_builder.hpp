@@ -7,6 +7,7 @@
 
 #include "fissure/host_sim/scene_description.hpp"
 
+class btRigidBody;
 class btSoftBody;
 struct btSoftBodyWorldInfo;
 
@@ -28,5 +29,20 @@ struct SurfaceMesh {
 /// config (kLST, kPR, kVC, kDP, kDF, piterations, margin, mass; kKHR = kCHR = 1, BRIEF §3).
 /// The caller owns the result (a btSoftRigidDynamicsWorld does not delete its bodies).
 [[nodiscard]] btSoftBody* build_soft_body(btSoftBodyWorldInfo& world_info, const SoftBodyDescription& description);
+
+/// The soft body's node positions as built (its rest shape, before any settling), world
+/// frame: what [[soft_body.anchor]] boxes select from (the loader checks each box selects one).
+[[nodiscard]] std::vector<Vec3> soft_body_rest_nodes_world_m(const SoftBodyDescription& description);
+
+/// Indices of the nodes (of `nodes_world_m`) inside `box`, bounds included, ascending.
+[[nodiscard]] std::vector<int> nodes_in_anchor_box(const std::vector<Vec3>& nodes_world_m, const SoftAnchorBox& box);
+
+/// Anchors the body's nodes selected by the description's anchor boxes (by their current
+/// positions: call right after build_soft_body, while the body is at rest) to `bed`, with
+/// Bullet's own anchors: the node keeps its mass and a rigid-contact-free link to the bed
+/// pulls it back to its rest place (btSoftBody::PSolve_Anchors, hardness Config::kAHR).
+/// Returns the number of anchored nodes. Throws std::invalid_argument naming the box when a
+/// box selects no node (a scene built in code; the loader reports it with file and line).
+int anchor_soft_body(btSoftBody& body, btRigidBody& bed, const SoftBodyDescription& description);
 
 }  // namespace fissure::host

@@ -65,6 +65,8 @@ class SoftWorld {
   /// Non-null only when the tool collides in Bullet.
   [[nodiscard]] ContactProbeSolver* probe() noexcept { return probe_; }
   [[nodiscard]] double sdf_voxel_m() const noexcept { return sdf_voxel_m_; }
+  /// Soft nodes tied to the ground by [[soft_body.anchor]] (0: a free body).
+  [[nodiscard]] int anchored_nodes_count() const noexcept { return anchored_nodes_count_; }
 
   /// Places a tool part (kinematic: Bullet derives its velocity from the previous pose).
   void set_part_pose(int part, const ToolPose& pose) noexcept;
@@ -89,6 +91,7 @@ class SoftWorld {
   std::array<std::unique_ptr<btRigidBody>, kMaxToolParts> parts_;
   std::unique_ptr<btSoftBody> soft_;
   bool parts_in_world_ = false;
+  int anchored_nodes_count_ = 0;
 };
 
 [[nodiscard]] ToolPose to_tool_pose(const Pose& pose) noexcept;
