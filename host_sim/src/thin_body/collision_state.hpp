@@ -12,7 +12,6 @@
 #include <vector>
 
 class btSoftBody;
-struct btDbvtNode;
 
 namespace fissure::host::thin_body {
 
@@ -49,6 +48,12 @@ struct ToolNodeBins {
   int cells_v = 1;
   std::vector<int> begin;  // CSR over cells_u * cells_v cells
   std::vector<int> nodes;
+  // In the same (bin) order as `nodes`, for the node sweep's inner loop (prepare_node_sweep):
+  std::vector<Eigen::Vector3d> positions_m;  // the node's tool-frame position
+  std::vector<int> planes;                   // the node's tool plane
+  // Per tool plane: the tool-frame bounds of its nodes (the sweep skips a whole plane for a
+  // triangle when no node of it can touch the triangle).
+  std::vector<Eigen::AlignedBox3d> plane_bounds_m;
 };
 
 struct CollisionModel {
@@ -101,7 +106,10 @@ struct CollisionData {
   std::vector<double> node_share;          // colliding node's share of its force (valid where moved_stamp == step):
                                            // 1 on the face, ramping to 0 over release_distance in front of it
   std::vector<int> candidate_nodes;
-  std::vector<const btDbvtNode*> tree_stack;
+  // Node sweep (node_sweep.cpp), per tool plane: a node of it was in contact last step / the
+  // current triangle may touch a node of it.
+  std::vector<std::uint8_t> sweep_plane_had_contact;
+  std::vector<std::uint8_t> sweep_plane_open;
   // Soft faces.
   std::vector<std::int64_t> face_candidate_stamp;
   std::vector<int> candidate_faces;
@@ -119,11 +127,11 @@ struct CollisionData {
   std::vector<double> hc_corner_rate_filtered_m_s;
 
   // ---- Broad phase only (broad_phase.cpp; sized on its first call) ----------------------------
-  bool broad_leaves_fitted = false;                  // node-tree leaves re-fitted once to the real margin
   std::vector<std::int64_t> broad_listed_stamp;      // soft node listed in candidate_nodes at this step
   std::vector<int> broad_previous_candidates;        // last step's candidate nodes (re-tested directly)
+  std::vector<int> broad_scan_hits;                  // nodes inside the scan's union box this step
   // What the last call visited (tests and the bench count these instead of timing them).
-  int broad_tree_nodes_visited = 0;   // node-tree nodes (internal + leaves) whose volume was tested
+  int broad_nodes_scanned = 0;        // soft nodes whose start/end positions the scan read (every node)
   int broad_seed_nodes = 0;           // soft nodes whose own start/end box met the query
   int broad_faces_tested = 0;         // soft faces whose tool-frame swept box was tested
 };
@@ -137,12 +145,14 @@ CollisionModel build_collision_model(const ToolNodes& tool, const btSoftBody& so
 void take_rest_state(const btSoftBody& soft, SoftSurfaceModel& model);
 void allocate_collision_data(const CollisionModel& model, CollisionData& data);
 
-// Stage 1 (broad_phase.cpp): swept tool bounds vs the soft body's node tree; on a hit, collects
-// candidate soft nodes / faces and their tool-frame start / end positions. false = out of contact.
-// Non-const body: the first call re-fits the node tree's leaves (once, see broad_phase.cpp).
-bool broad_phase(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft, CollisionData& data);
+// Stage 1 (broad_phase.cpp): swept tool bounds vs every soft node's start / end position; on a hit,
+// collects candidate soft nodes / faces and their tool-frame start / end positions. false = out
+// of contact.
+bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data);
 // Stage 2 (node_sweep.cpp): every tool node against the candidate triangles, swept over the step.
 void sweep_tool_nodes(const CollisionModel& model, CollisionData& data);
+// Load time: the bin-ordered node tables and per-plane bounds the sweep reads (fills bins' tables).
+void prepare_node_sweep(const ToolNodes& tool, ToolNodeBins& bins);
 // Stage 3 (pair_exclusion.cpp): infeasible pairs → exclusion vector (paired only); assigns each
 // contacted face the tool plane of its leading node. Returns the number of both-face contacts left.
 int exclude_infeasible_pairs(const CollisionModel& model, CollisionData& data);

@@ -14,16 +14,28 @@
 //     projects inside the interpolated triangle A + τ(B − A). Nodes already touching use τ = 1
 //     (the triangle under them now, so a sliding contact moves from triangle to triangle).
 // The earliest crossing wins when several triangles qualify.
+//
+// Cost: a triangle visits the tool nodes binned under its swept footprint. Before that, each tool
+// plane is tested as a whole against the two conditions above, on the box of its nodes in the
+// visited cells (the extreme of a plane equation over a box is at a corner): a plane whose nodes all
+// end in front of the triangle, or all start behind it (with none in contact last step, or all
+// beyond the memory depth), is skipped. For a plate pressed face-first into a soft body that skips
+// the far face and the rims — half or more of the nodes under a large triangle.
 #include "collision_state.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace fissure::host::thin_body {
 namespace {
 
 // Barycentric tolerance so that a node exactly on a shared edge is caught by both triangles.
 constexpr double kBarycentricTolerance = 1e-7;
+// The plane-level test evaluates the same signed distances as the node test in another order:
+// this much slack (far below any contact distance, far above double rounding at tool sizes)
+// keeps it from skipping a plane whose node the node test would just keep.
+constexpr double kPlaneSkipSlack_m = 1e-12;
 
 struct Triangle {
   Eigen::Vector3d a, b, c, normal;
@@ -61,14 +73,42 @@ bool projects_inside(const Triangle& t, const Eigen::Vector3d& p) {
   return v >= -kBarycentricTolerance && w >= -kBarycentricTolerance && v + w <= 1.0 + kBarycentricTolerance;
 }
 
+// Smallest and largest of n·x − d over a box: the extremes of a linear function are at corners.
+double min_over_box(const Eigen::Vector3d& n, double d, const Eigen::AlignedBox3d& box) {
+  return n.dot(box.center()) - d - n.cwiseAbs().dot(0.5 * box.sizes());
+}
+double max_over_box(const Eigen::Vector3d& n, double d, const Eigen::AlignedBox3d& box) {
+  return n.dot(box.center()) - d + n.cwiseAbs().dot(0.5 * box.sizes());
+}
+
 }  // namespace
 
+void prepare_node_sweep(const ToolNodes& tool, ToolNodeBins& bins) {
+  const auto& positions = tool.positions_tool_m();
+  const auto& plane_of_node = tool.plane_of_node();
+  bins.positions_m.resize(bins.nodes.size());
+  bins.planes.resize(bins.nodes.size());
+  for (std::size_t b = 0; b < bins.nodes.size(); ++b) {
+    const auto node = static_cast<std::size_t>(bins.nodes[b]);
+    bins.positions_m[b] = positions[node];
+    bins.planes[b] = plane_of_node[node];
+  }
+  bins.plane_bounds_m.assign(tool.planes().size(), Eigen::AlignedBox3d());
+  for (std::size_t i = 0; i < positions.size(); ++i)
+    bins.plane_bounds_m[static_cast<std::size_t>(plane_of_node[i])].extend(positions[i]);
+}
+
 void sweep_tool_nodes(const CollisionModel& model, CollisionData& data) {
+  // Which planes had a node in contact last step (before this step's lists are reset).
+  std::fill(data.sweep_plane_had_contact.begin(), data.sweep_plane_had_contact.end(), 0);
+  for (const int node : data.contact_nodes)
+    if (data.node_face[static_cast<std::size_t>(node)] >= 0)
+      data.sweep_plane_had_contact[static_cast<std::size_t>(model.tool.plane_of_node()[static_cast<std::size_t>(node)])] = 1;
   data.node_face.swap(data.node_face_prev);
   std::fill(data.node_face.begin(), data.node_face.end(), -1);
   data.contact_nodes.clear();
-  const auto& positions = model.tool.positions_tool_m();
   const auto& normals = model.tool.normals_tool();
+  const std::size_t plane_count = model.bins.plane_bounds_m.size();
   const ToolNodeBins& bins = model.bins;
   const double contact = model.params.contact_distance_m;
   const double sign = model.soft.outward_sign;
@@ -96,15 +136,47 @@ void sweep_tool_nodes(const CollisionModel& model, CollisionData& data) {
     if (swept.max()[bins.axis_u] + pad < bins.origin_u || swept.min()[bins.axis_u] - pad > bins.origin_u + bins.cells_u * bins.cell_m ||
         swept.max()[bins.axis_v] + pad < bins.origin_v || swept.min()[bins.axis_v] - pad > bins.origin_v + bins.cells_v * bins.cell_m)
       continue;
+    // The planes that may touch this triangle: their nodes in the cells visited below neither all
+    // end in front of it nor all start behind it. The cells' extent (edge cells also hold the
+    // nodes clamped into them: unbounded there; a little slack for the binning's rounding) bounds
+    // every node the loop reaches, so a skipped plane only drops nodes the node test would drop.
+    constexpr double kInfinity = std::numeric_limits<double>::infinity();
+    constexpr double kCellSlack_m = 1e-9;
+    const double cells_u_lo = u0 == 0 ? -kInfinity : bins.origin_u + u0 * bins.cell_m - kCellSlack_m;
+    const double cells_u_hi = u1 == bins.cells_u - 1 ? kInfinity : bins.origin_u + (u1 + 1) * bins.cell_m + kCellSlack_m;
+    const double cells_v_lo = v0 == 0 ? -kInfinity : bins.origin_v + v0 * bins.cell_m - kCellSlack_m;
+    const double cells_v_hi = v1 == bins.cells_v - 1 ? kInfinity : bins.origin_v + (v1 + 1) * bins.cell_m + kCellSlack_m;
+    const double d_end = end.normal.dot(end.a);
+    const double d_start = start.normal.dot(start.a);
+    bool any_open = false;
+    for (std::size_t plane = 0; plane < plane_count; ++plane) {
+      Eigen::AlignedBox3d under = bins.plane_bounds_m[plane];
+      under.min()[bins.axis_u] = std::max(under.min()[bins.axis_u], cells_u_lo);
+      under.max()[bins.axis_u] = std::min(under.max()[bins.axis_u], cells_u_hi);
+      under.min()[bins.axis_v] = std::max(under.min()[bins.axis_v], cells_v_lo);
+      under.max()[bins.axis_v] = std::min(under.max()[bins.axis_v], cells_v_hi);
+      bool open = !under.isEmpty();
+      if (open && min_over_box(end.normal, d_end, under) > contact + kPlaneSkipSlack_m) open = false;
+      if (open) {
+        const double s_start_max = max_over_box(start.normal, d_start, under);
+        const bool memory_may_hold = data.sweep_plane_had_contact[plane] != 0 && s_start_max >= -model.memory_depth_m - kPlaneSkipSlack_m;
+        if (s_start_max < -contact - kPlaneSkipSlack_m && !memory_may_hold) open = false;
+      }
+      data.sweep_plane_open[plane] = open ? 1 : 0;
+      any_open = any_open || open;
+    }
+    if (!any_open) continue;
     for (int cu = u0; cu <= u1; ++cu) {
       for (int cv = v0; cv <= v1; ++cv) {
         const int cell = cu * bins.cells_v + cv;
         for (int b = bins.begin[static_cast<std::size_t>(cell)]; b < bins.begin[static_cast<std::size_t>(cell + 1)]; ++b) {
-          const int node = bins.nodes[static_cast<std::size_t>(b)];
-          const auto n = static_cast<std::size_t>(node);
-          const Eigen::Vector3d& p = positions[n];
+          const auto bin = static_cast<std::size_t>(b);
+          if (data.sweep_plane_open[static_cast<std::size_t>(bins.planes[bin])] == 0) continue;
+          const Eigen::Vector3d& p = bins.positions_m[bin];
           const double s_end = end.normal.dot(p - end.a);
           if (s_end > contact) continue;
+          const int node = bins.nodes[bin];
+          const auto n = static_cast<std::size_t>(node);
           const double s_start = start.normal.dot(p - start.a);
           const bool was_in_contact = data.node_face_prev[n] >= 0;
           if (s_start < -contact && !(was_in_contact && s_start >= -model.memory_depth_m)) continue;
