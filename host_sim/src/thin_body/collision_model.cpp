@@ -103,6 +103,7 @@ CollisionModel build_collision_model(const ToolNodes& tool, const btSoftBody& so
       !std::isfinite(hc.n))
     throw std::invalid_argument("thin-body collision: Hunt-Crossley k, lambda >= 0 and n > 0 (finite)");
   CollisionModel model{tool, build_bins(tool), SoftSurfaceModel{}, params, paired, 0.0, {}};
+  prepare_node_sweep(model.tool, model.bins);
   SoftSurfaceModel& surface = model.soft;
   surface.node_count = soft.m_nodes.size();
   surface.face_count = soft.m_faces.size();
@@ -161,8 +162,8 @@ void allocate_collision_data(const CollisionModel& model, CollisionData& data) {
   data.node_share.assign(soft_nodes, 0.0);
   data.candidate_nodes.clear();
   data.candidate_nodes.reserve(soft_nodes);
-  data.tree_stack.clear();
-  data.tree_stack.reserve(2 * soft_nodes + 64);  // a binary tree of N leaves has 2N-1 nodes
+  data.sweep_plane_had_contact.assign(model.tool.planes().size(), 0);
+  data.sweep_plane_open.assign(model.tool.planes().size(), 0);
   data.face_candidate_stamp.assign(soft_faces, -1);
   data.candidate_faces.clear();
   data.candidate_faces.reserve(soft_faces);
