@@ -114,6 +114,39 @@ TEST(Tick, ProxySwapChangesTheForceByAtMostTheBlendBoundPerTick) {
   EXPECT_NEAR(previous, h.expected_force_y(3.0 * kStiffness_n_per_m), 1e-9);
 }
 
+// Issue 6's bound is on the rendered contact force, and the tool moves while a swap blends:
+// the swap's walk shares the bound with the motion's own step (proxy_blend.hpp). Here the
+// tool presses into the plane 20 µm per tick (≈ 0.025 N per encoder count at 500 N/m) while a
+// 2 N swap offset walks out; before session 4 every tick with a count change stepped by
+// 0.05 N + the motion.
+TEST(Tick, ProxySwapWhileTheToolMovesKeepsTheRenderedStepWithinTheBound) {
+  Harness h;
+  h.settle();
+  const double bound = h.model.config.proxy.blend_max_step_n;
+  constexpr double kNewPlaneY_m = kPlaneY_m + 0.004;  // the host's new plane: +2 N at 500 N/m
+  double previous = h.data.contact_force_device_n.y();
+  double previous_y_m = h.data.p_device_m.y();
+  double max_step = 0.0;
+  double max_motion = 0.0;
+  Eigen::Vector3d p = kCentre_device_m;
+  for (int i = 0; i < 200; ++i) {
+    p.y() -= 20e-6;
+    h.device.place(p);
+    h.publish(kStiffness_n_per_m, kNewPlaneY_m);
+    h.step();
+    const double y = h.data.contact_force_device_n.y();
+    max_step = std::max(max_step, std::fabs(y - previous));
+    max_motion = std::max(max_motion, kStiffness_n_per_m * std::fabs(h.data.p_device_m.y() - previous_y_m));
+    previous = y;
+    previous_y_m = h.data.p_device_m.y();
+  }
+  ASSERT_GT(max_motion, 0.01);     // the tool did move, by whole encoder counts
+  ASSERT_LT(max_motion, bound);    // … each within the bound by itself
+  EXPECT_LE(max_step, bound + 1e-12);
+  EXPECT_FALSE(blending(h.data.blend));  // and the offset did walk out meanwhile
+  EXPECT_NEAR(previous, kStiffness_n_per_m * (kNewPlaneY_m - h.data.p_device_m.y()), 1e-9);
+}
+
 TEST(Tick, StaleProxyFadesToZeroWithinItsBoundAndRecovers) {
   Harness h;
   h.settle();

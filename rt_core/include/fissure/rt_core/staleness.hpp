@@ -11,8 +11,9 @@
 namespace fissure::rt {
 
 struct ProxyConfig {
-  /// Max |ΔF| per tick caused by a proxy swap [N]: issue 6's target for the whole session
-  /// is ≤ 0.05 N per tick, so a swap alone may not use more.
+  /// Max |ΔF| per tick of the rendered contact force while a swap blends [N]: issue 6's
+  /// target for the whole session is ≤ 0.05 N per tick, and the swap's walk shares it with the
+  /// tool's motion (proxy_blend.hpp) — a tick's step is ≤ max(this, the motion's own step).
   double blend_max_step_n = 0.05;
   /// A proxy older than this is stale [s]. The slowest host rate we support is 50 Hz
   /// (issue 6) = 20 ms per step; 100 ms tolerates four lost steps before fading.
