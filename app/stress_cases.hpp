@@ -156,6 +156,10 @@ struct StressRow {
   double recovery_max_s = 0.0;
   std::uint64_t contact_ticks = 0;      ///< rt ticks that rendered at least one contact patch
   double min_contact_fraction = 0.0;    ///< what the case requires of contact_ticks / ticks
+  /// Lowest enclosed volume of the soft body over the run, as a fraction of its settled volume
+  /// (Bullet's signed volume, so < 0 means the surface is turned inside out: the one-sided paired
+  /// collision then meets no triangle from outside — a failure the crossed-node count cannot see).
+  double soft_volume_ratio_min = 1.0;
   double wall_s = 0.0;
   std::string note;
 };

@@ -8,7 +8,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(StressRow, name, group, seed, passed, known_f
                                    force_limit_n, energy_max_j, energy_bound_j, crossed_nodes_max, host_penetration_max_mm,
                                    fault_bits_seen, fault_bits_allowed, fault_onsets, proxies_rejected, injected_events,
                                    recoveries_required, recoveries_done, recovery_max_s, contact_ticks, min_contact_fraction,
-                                   wall_s, note)
+                                   soft_volume_ratio_min,                                   wall_s, note)
 
 nlohmann::json stress_row_to_json(const StressRow& r) {
   nlohmann::json j = r;
