@@ -96,8 +96,8 @@ CollisionModel build_collision_model(const ToolNodes& tool, const btSoftBody& so
     throw std::invalid_argument("thin-body collision: need skin_m > 0 and contact_distance_m >= skin_m");
   if (!(params.release_distance_m >= 0.0))
     throw std::invalid_argument("thin-body collision: release_distance_m must be >= 0");
-  if (!(params.velocity_filter_cutoff_hz > 0.0) || !(params.broad_phase_margin_m >= 0.0))
-    throw std::invalid_argument("thin-body collision: velocity_filter_cutoff_hz > 0 and broad_phase_margin_m >= 0");
+  if (!(params.velocity_filter_cutoff_hz > 0.0))
+    throw std::invalid_argument("thin-body collision: velocity_filter_cutoff_hz must be > 0");
   const auto& hc = params.hunt_crossley;
   if (!(hc.k >= 0.0) || !(hc.lambda >= 0.0) || !(hc.n > 0.0) || !std::isfinite(hc.k) || !std::isfinite(hc.lambda) ||
       !std::isfinite(hc.n))

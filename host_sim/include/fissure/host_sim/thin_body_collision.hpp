@@ -121,8 +121,6 @@ struct ThinBodyCollisionParams {
   // ẋ is a finite difference of x filtered by a first-order low-pass with this cut-off
   // (time constant 1/(2π·fc), i.e. ≈1.6 ms lag at 100 Hz).
   double velocity_filter_cutoff_hz = 100.0;
-  // Broad-phase inflation of the swept tool bounds (covers soft motion within a step).
-  double broad_phase_margin_m = 0.005;
   // Reported in ContactRecord::jaw so that a clamp can run one instance per jaw.
   int jaw = 0;
 };
