@@ -26,6 +26,7 @@
 
 #include "commands.hpp"
 #include "fissure/host_sim/host_simulation.hpp"
+#include "fissure/host_sim/plunge_hold.hpp"
 #include "fissure/host_sim/scene_loader.hpp"
 #include "sim_report.hpp"
 
@@ -37,32 +38,17 @@ using host::HostSimulation;
 using host::SceneCollisionMethod;
 using host::SceneDescription;
 
-// Where the leading face of the tool starts above the settled soft surface, and how deep
-// it goes in the sweep (BRIEF §3's measurement: a plate driven down into the sphere).
-constexpr double kSweepStartClearanceM = 0.015;
-constexpr double kSweepDepthM = 0.02;
-constexpr double kSettleS = 0.3;
-// After the plunge stops, the hold's force is measured only after this settling window: a fast
-// plunge hands the enforced nodes the tool's speed and they keep it for one step when the tool
-// stops (the light shell rings or is dented away from the plate), which is the soft body's
-// response to the impact, not force noise of the contact at rest.
-constexpr double kHoldSettleS = 0.05;
-// Pose-matching coefficient (Bullet kMT) of the indentation / convergence specimens; 0.05 is
-// the collision unit tests' springy ball (tests/host_sim/soft_scene_fixture.hpp).
-constexpr double kShapeMatchingRatio = 0.05;
+// Settling time of the indentation / convergence specimens under gravity [s] (the sweep's own,
+// host::kPlungeSettle_s).
+constexpr double kSettleS = host::kPlungeSettle_s;
+// Pose-matching coefficient (Bullet kMT) of the indentation / convergence specimens: the sweep
+// ball's (host/plunge_hold.hpp says why a springy ball).
+constexpr double kShapeMatchingRatio = host::kPlungeShapeMatchingRatio;
 
 struct BenchOptions {
   std::string json_path;
   bool quick = false;
   bool full = false;
-};
-
-struct SweepTool {
-  std::string name;
-  host::ToolKind kind;
-  Vec3 size_m;          // box
-  Vec3 rpy_deg;         // orientation
-  double leading_half_m;  // distance from the tool origin to its leading (lowest) point
 };
 
 using Clock = std::chrono::steady_clock;
@@ -77,62 +63,6 @@ double load_average() {
 }
 
 SceneDescription base_scene() { return host::load_scene(host::resolve_scene_path("spatula-sphere")); }
-
-Quat quat_rpy_deg(const Vec3& rpy) {
-  const double k = M_PI / 360.0;
-  const double cr = std::cos(rpy[0] * k), sr = std::sin(rpy[0] * k), cp = std::cos(rpy[1] * k), sp = std::sin(rpy[1] * k);
-  const double cy = std::cos(rpy[2] * k), sy = std::sin(rpy[2] * k);
-  return {cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy};
-}
-
-SceneDescription with_tool(const SceneDescription& base, const SweepTool& tool) {
-  SceneDescription s = base;
-  if (tool.kind == host::ToolKind::kConvexMesh) {
-    const SceneDescription convex = host::load_scene(host::resolve_scene_path("convex-spatula-sphere"));
-    s.tool = convex.tool;
-  } else {
-    s.tool.kind = host::ToolKind::kBox;
-    s.tool.box_size_m = tool.size_m;
-  }
-  s.trajectory.start.orientation_world = quat_rpy_deg(tool.rpy_deg);
-  // The hold after the plunge needs a ball that pushes back. The paper's shell (edge links, no
-  // pressure) has no restoring force: a plunge at >= 5 m/s hands the nodes under the plate the
-  // plate's speed, the cap snaps through into a dent when the plate stops, stays there, and the
-  // held plate measures nothing (session 1: every paired cell at >= 10 m/s 'lost'). Pose matching
-  // (Bullet kMT, the same springy ball as the indentation specimens and the unit tests) pulls the
-  // cap back against the plate; the collision methods and the tunnelling are unchanged by it.
-  s.soft_body.shape_matching_ratio = kShapeMatchingRatio;
-  return s;
-}
-
-struct LineFit {
-  double mean = 0.0, slope_per_sample = 0.0, residual_stddev = 0.0;
-};
-
-// Least-squares line through v[i] against i; residual standard deviation with n − 2 dof.
-LineFit fit_line(const std::vector<double>& v) {
-  LineFit fit;
-  const auto n = static_cast<double>(v.size());
-  if (v.empty()) return fit;
-  for (double x : v) fit.mean += x;
-  fit.mean /= n;
-  if (v.size() < 3) return fit;
-  const double i_mean = 0.5 * (n - 1.0);
-  double sii = 0.0, siy = 0.0;
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    const double di = static_cast<double>(i) - i_mean;
-    sii += di * di;
-    siy += di * (v[i] - fit.mean);
-  }
-  fit.slope_per_sample = siy / sii;
-  double ss = 0.0;
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    const double r = v[i] - fit.mean - fit.slope_per_sample * (static_cast<double>(i) - i_mean);
-    ss += r * r;
-  }
-  fit.residual_stddev = std::sqrt(ss / (n - 2.0));
-  return fit;
-}
 
 // Least-squares slope of log F against log d (points with F > 0).
 double fitted_exponent(const std::vector<std::pair<double, double>>& curve) {
@@ -149,82 +79,6 @@ double fitted_exponent(const std::vector<std::pair<double, double>>& curve) {
   }
   if (n < 2) return 0.0;
   return (n * sxy - sx * sy) / (n * sxx - sx * sx);
-}
-
-struct SweepCell {
-  int crossed = 0, wrong_side = 0, inside = 0;
-  double max_penetration_m = 0.0, hold_force_n = 0.0, median_us = 0.0, p99_us = 0.0;
-  // Over the hold's measuring window (hold_s after a kHoldSettleS settling window), |F(t)| sampled
-  // every step and fitted by a least-squares line:
-  //   std_over_mean = sample standard deviation / mean (everything that moves, trend included);
-  //   jitter        = standard deviation of the residual about the line / mean (the step-to-step
-  //                   fluctuation: what the target "hold jitter ≤ 1 %" is about);
-  //   drift         = the line's change over the window / mean (the soft body's slow physical
-  //                   relaxation under a held tool — reported, not hidden, not a target);
-  //   step_noise    = standard deviation of the step-to-step change / √2 / mean: the part of the
-  //                   jitter that changes every step (contact-set chatter, a buzz in the hand),
-  //                   as opposed to the ball's own ringing, which moves the force over many steps.
-  // All fractions; undefined (no contact) when the mean force is 0 — the plate lost the ball.
-  double jitter = 0.0, drift = 0.0, std_over_mean = 0.0, step_noise = 0.0;
-  bool in_contact = false;
-};
-
-SweepCell run_sweep_cell(const SceneDescription& scene, SceneCollisionMethod method, double speed_m_s, double leading_half_m, double hold_s) {
-  HostSimulation sim(scene, method);
-  const double dt = scene.simulation.time_step_s;
-  // Start well clear, settle, then find the soft surface's top.
-  host::ToolPose pose = host::to_tool_pose(scene.trajectory.start);
-  pose.position_world_m.y() = 0.2;
-  (void)sim.step(pose);
-  sim.settle(kSettleS);
-  const double top_m = sim.soft_bounds_world_m().max().y();
-  pose.position_world_m.y() = top_m + kSweepStartClearanceM + leading_half_m;
-  const double end_y = top_m - kSweepDepthM + leading_half_m;
-  // Put the tool at the start pose first (out of contact): plunging straight from the settle
-  // pose (0.2 m) would make the first plunge step a ~0.12 m jump, i.e. well above the nominal speed.
-  (void)sim.step(pose);
-  SweepCell cell;
-  std::vector<double> step_s, hold_force;
-  auto record = [&](const host::HostStepResult& r) {
-    cell.crossed = std::max(cell.crossed, r.crossing.crossed_nodes);
-    cell.wrong_side = std::max(cell.wrong_side, r.crossing.wrong_side_nodes);
-    cell.inside = std::max(cell.inside, r.crossing.inside_nodes);
-    cell.max_penetration_m = std::max(cell.max_penetration_m, r.crossing.max_penetration_m);
-    step_s.push_back(r.times.total_s);
-  };
-  while (pose.position_world_m.y() > end_y) {
-    pose.position_world_m.y() = std::max(end_y, pose.position_world_m.y() - speed_m_s * dt);
-    record(sim.step(pose));
-  }
-  const long settle_steps = std::lround(kHoldSettleS / dt);
-  const long hold_steps = std::lround(hold_s / dt);
-  for (long i = 0; i < settle_steps + hold_steps; ++i) {
-    const host::HostStepResult& r = sim.step(pose);
-    record(r);
-    if (i >= settle_steps) hold_force.push_back(r.force_on_tool_world_n.norm());
-  }
-  const LineFit fit = fit_line(hold_force);
-  cell.in_contact = fit.mean > 0.0;
-  cell.jitter = cell.in_contact ? fit.residual_stddev / fit.mean : 0.0;
-  cell.drift = cell.in_contact ? fit.slope_per_sample * static_cast<double>(hold_force.size()) / fit.mean : 0.0;
-  double sum_sq = 0.0;
-  for (double f : hold_force) sum_sq += (f - fit.mean) * (f - fit.mean);
-  cell.std_over_mean = cell.in_contact && hold_force.size() > 1 ? std::sqrt(sum_sq / static_cast<double>(hold_force.size() - 1)) / fit.mean : 0.0;
-  if (cell.in_contact && hold_force.size() > 2) {
-    std::vector<double> change;
-    for (std::size_t i = 1; i < hold_force.size(); ++i) change.push_back(hold_force[i] - hold_force[i - 1]);
-    double change_mean = 0.0, change_sq = 0.0;
-    for (double d : change) change_mean += d;
-    change_mean /= static_cast<double>(change.size());
-    for (double d : change) change_sq += (d - change_mean) * (d - change_mean);
-    cell.step_noise = std::sqrt(change_sq / static_cast<double>(change.size() - 1)) / std::sqrt(2.0) / fit.mean;
-  }
-  double mean = 0.0;
-  for (double f : hold_force) mean += f;
-  cell.hold_force_n = hold_force.empty() ? 0.0 : mean / static_cast<double>(hold_force.size());
-  cell.median_us = sim_quantile(step_s, 0.5) * 1e6;
-  cell.p99_us = sim_quantile(step_s, 0.99) * 1e6;
-  return cell;
 }
 
 // Quasi-static indentation: step the tool down in increments, hold each depth so the
@@ -290,49 +144,47 @@ nlohmann::json run_bench(const BenchOptions& o) {
 
   // ---- 1. Tunnelling sweep. -------------------------------------------------------------
   const std::vector<double> speeds = o.quick ? std::vector<double>{0.1, 10.0, 50.0} : std::vector<double>{0.1, 0.5, 1, 2, 5, 10, 20, 50};
-  const std::vector<SweepTool> tools = {
-      {"plate_4mm", host::ToolKind::kBox, {0.04, 0.004, 0.04}, {0, 0, 0}, 0.002},
-      {"plate_1mm", host::ToolKind::kBox, {0.04, 0.001, 0.04}, {0, 0, 0}, 0.0005},
-      // Thin axis (tool y) turned to world x: the 40 mm edge leads downwards.
-      {"blade_edge_first", host::ToolKind::kBox, {0.04, 0.001, 0.04}, {0, 0, -90}, 0.02},
-      {"convex_spatula", host::ToolKind::kConvexMesh, {0, 0, 0}, {0, 0, 0}, 0.001},
-  };
+  const auto& tools = host::plunge_tools();
   const std::vector<SceneCollisionMethod> methods = {SceneCollisionMethod::kBullet, SceneCollisionMethod::kRay, SceneCollisionMethod::kPaired};
   const double hold_s = o.quick ? 0.1 : 0.5;
   nlohmann::json sweep = nlohmann::json::array();
   SimProgress progress("bench collision: sweep", static_cast<long>(speeds.size() * tools.size() * methods.size()));
   long done = 0;
   std::printf("\n1. Tunnelling sweep (sphere 128 faces with pose matching kMT %.2f, 1 kHz, plunge %.0f mm, hold %.1f s)\n", kShapeMatchingRatio,
-              kSweepDepthM * 1e3, hold_s);
-  out["sweep_body"] = {{"faces", 128}, {"shape_matching_ratio", kShapeMatchingRatio}, {"plunge_depth_m", kSweepDepthM}, {"hold_s", hold_s},
-                       {"hold_settle_s", kHoldSettleS}};
+              host::kPlungeDepth_m * 1e3, hold_s);
+  out["sweep_body"] = {{"faces", 128}, {"shape_matching_ratio", kShapeMatchingRatio}, {"plunge_depth_m", host::kPlungeDepth_m}, {"hold_s", hold_s},
+                       {"hold_settle_s", host::kHoldSettle_s}};
   std::printf("(hold: |F| every step for %.1f s after a %.0f ms settling window, fitted by a line; in %% of the mean force:\n"
               " jitter = residual std about the line, std = plain std, step = std of the step-to-step change / sqrt 2,\n"
-              " drift = the line's change over the hold (the soft body relaxing); 'lost' = no contact left in the hold)\n", hold_s, kHoldSettleS * 1e3);
+              " drift = the line's change over the hold (the soft body relaxing); 'lost' = no contact left in the hold)\n", hold_s, host::kHoldSettle_s * 1e3);
   std::printf("%-17s %-7s %7s | %7s %7s %7s | %9s %8s %8s %8s %8s %9s %9s\n", "tool", "method", "v m/s", "crossed", "wrong", "inside", "pen mm",
               "jitter%", "std%", "step%", "drift%", "F_hold N", "med us");
-  for (const SweepTool& tool : tools) {
-    const SceneDescription scene = with_tool(base, tool);
+  for (const host::PlungeTool& tool : tools) {
+    const SceneDescription scene = host::plunge_scene(tool);
+    const std::string tool_name(tool.name);
     for (SceneCollisionMethod method : methods) {
       for (double v : speeds) {
-        const SweepCell c = run_sweep_cell(scene, method, v, tool.leading_half_m, hold_s);
-        progress.update(++done, tool.name + " " + host::to_string(method));
+        const host::PlungeHoldResult c = host::run_plunge_hold(scene, method, v, tool.leading_half_m, hold_s);
+        const host::HoldForceStats& h = c.hold;
+        const double median_us = sim_quantile(c.step_s, 0.5) * 1e6;
+        const double p99_us = sim_quantile(c.step_s, 0.99) * 1e6;
+        progress.update(++done, tool_name + " " + host::to_string(method));
         char jitter[16] = "lost", drift[16] = "lost", std_over_mean[16] = "lost", step_noise[16] = "lost";
-        if (c.in_contact) {
-          std::snprintf(jitter, sizeof jitter, "%.3f", 100.0 * c.jitter);
-          std::snprintf(std_over_mean, sizeof std_over_mean, "%.3f", 100.0 * c.std_over_mean);
-          std::snprintf(step_noise, sizeof step_noise, "%.3f", 100.0 * c.step_noise);
-          std::snprintf(drift, sizeof drift, "%+.2f", 100.0 * c.drift);
+        if (h.in_contact) {
+          std::snprintf(jitter, sizeof jitter, "%.3f", 100.0 * h.jitter);
+          std::snprintf(std_over_mean, sizeof std_over_mean, "%.3f", 100.0 * h.std_over_mean);
+          std::snprintf(step_noise, sizeof step_noise, "%.3f", 100.0 * h.step_noise);
+          std::snprintf(drift, sizeof drift, "%+.2f", 100.0 * h.drift);
         }
-        std::printf("\r%-17s %-7s %7.1f | %7d %7d %7d | %9.3f %8s %8s %8s %8s %9.3f %9.1f\033[K\n", tool.name.c_str(), host::to_string(method), v, c.crossed,
-                    c.wrong_side, c.inside, c.max_penetration_m * 1e3, jitter, std_over_mean, step_noise, drift, c.hold_force_n, c.median_us);
-        sweep.push_back({{"method", host::to_string(method)}, {"tool", tool.name}, {"speed_m_s", v}, {"crossed_nodes", c.crossed},
-                         {"wrong_side_nodes", c.wrong_side}, {"inside_nodes", c.inside}, {"max_penetration_m", c.max_penetration_m},
-                         {"force_jitter", c.in_contact ? nlohmann::json(c.jitter) : nlohmann::json(nullptr)},
-                         {"force_std_over_mean", c.in_contact ? nlohmann::json(c.std_over_mean) : nlohmann::json(nullptr)},
-                         {"force_step_noise", c.in_contact ? nlohmann::json(c.step_noise) : nlohmann::json(nullptr)},
-                         {"force_drift", c.in_contact ? nlohmann::json(c.drift) : nlohmann::json(nullptr)},
-                         {"hold_in_contact", c.in_contact}, {"hold_settle_s", kHoldSettleS}, {"hold_force_n", c.hold_force_n}, {"step_median_us", c.median_us}, {"step_p99_us", c.p99_us}});
+        std::printf("\r%-17s %-7s %7.1f | %7d %7d %7d | %9.3f %8s %8s %8s %8s %9.3f %9.1f\033[K\n", tool_name.c_str(), host::to_string(method), v,
+                    c.crossed_nodes, c.wrong_side_nodes, c.inside_nodes, c.max_penetration_m * 1e3, jitter, std_over_mean, step_noise, drift, h.mean_n,
+                    median_us);
+        const auto if_contact = [&](double x) { return h.in_contact ? nlohmann::json(x) : nlohmann::json(nullptr); };
+        sweep.push_back({{"method", host::to_string(method)}, {"tool", tool_name}, {"speed_m_s", v}, {"crossed_nodes", c.crossed_nodes},
+                         {"wrong_side_nodes", c.wrong_side_nodes}, {"inside_nodes", c.inside_nodes}, {"max_penetration_m", c.max_penetration_m},
+                         {"force_jitter", if_contact(h.jitter)}, {"force_std_over_mean", if_contact(h.std_over_mean)},
+                         {"force_step_noise", if_contact(h.step_noise)}, {"force_drift", if_contact(h.drift)}, {"hold_in_contact", h.in_contact},
+                         {"hold_settle_s", host::kHoldSettle_s}, {"hold_force_n", h.mean_n}, {"step_median_us", median_us}, {"step_p99_us", p99_us}});
       }
     }
   }

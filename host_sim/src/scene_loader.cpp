@@ -249,14 +249,6 @@ std::string child_path(const TableReader& parent, const std::string& key) {
   return parent.path().empty() ? key : parent.path() + "." + key;
 }
 
-Quat quat_from_rpy_deg(const Vec3& rpy_deg) {
-  // Rotation R = Rz(yaw)·Ry(pitch)·Rx(roll) (extrinsic x, then y, then z), as a unit quaternion.
-  constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
-  const double hr = 0.5 * rpy_deg[0] * kDegToRad, hp = 0.5 * rpy_deg[1] * kDegToRad, hy = 0.5 * rpy_deg[2] * kDegToRad;
-  const double cr = std::cos(hr), sr = std::sin(hr), cp = std::cos(hp), sp = std::sin(hp), cy = std::cos(hy), sy = std::sin(hy);
-  return {cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy};
-}
-
 void read_simulation(TableReader& t, SimulationDescription& sim) {
   sim.time_step_s = t.in_range("time_step", "s", 1e-6, 0.1);
   sim.substeps_count = t.count("substeps", 1, 1000);
@@ -632,6 +624,14 @@ std::filesystem::path resolve_scene_path(std::string_view name_or_path) {
   }
   throw SceneError(std::string(name_or_path), 0, "",
                    "no such scene file or scene name (looked in " + (dir.empty() ? std::string("no scenes/ directory found") : dir.string()) + ")");
+}
+
+Quat quat_from_rpy_deg(const Vec3& rpy_deg) {
+  // Rotation R = Rz(yaw)·Ry(pitch)·Rx(roll) (extrinsic x, then y, then z), as a unit quaternion.
+  constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
+  const double hr = 0.5 * rpy_deg[0] * kDegToRad, hp = 0.5 * rpy_deg[1] * kDegToRad, hy = 0.5 * rpy_deg[2] * kDegToRad;
+  const double cr = std::cos(hr), sr = std::sin(hr), cp = std::cos(hp), sp = std::sin(hp), cy = std::cos(hy), sy = std::sin(hy);
+  return {cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy};
 }
 
 }  // namespace fissure::host

@@ -44,4 +44,8 @@ class SceneError : public std::runtime_error {
 /// The scenes/ directory found as above (empty when none).
 [[nodiscard]] std::filesystem::path find_scenes_dir();
 
+/// Roll, pitch, yaw [deg] → unit quaternion (w, x, y, z) of R = Rz(yaw)·Ry(pitch)·Rx(roll), the
+/// convention of the scene files' `*_rpy_deg` keys.
+[[nodiscard]] Quat quat_from_rpy_deg(const Vec3& rpy_deg);
+
 }  // namespace fissure::host
