@@ -48,9 +48,11 @@ struct ToolNodeBins {
   int cells_v = 1;
   std::vector<int> begin;  // CSR over cells_u * cells_v cells
   std::vector<int> nodes;
-  // In the same (bin) order as `nodes`, for the node sweep's inner loop (prepare_node_sweep):
-  std::vector<Eigen::Vector3d> positions_m;  // the node's tool-frame position
-  std::vector<int> planes;                   // the node's tool plane
+  // The node sweep's tables (prepare_node_sweep): each tool plane's nodes binned alone, so that a
+  // skipped plane's nodes are never read and a row of cells is one contiguous run of nodes.
+  std::vector<int> plane_cell_begin;              // CSR over planes × cells (plane * cells_u * cells_v + cell)
+  std::vector<int> plane_cell_nodes;              // tool node index
+  std::vector<Eigen::Vector3d> plane_cell_positions_m;  // its tool-frame position
   // Per tool plane: the tool-frame bounds of its nodes (the sweep skips a whole plane for a
   // triangle when no node of it can touch the triangle).
   std::vector<Eigen::AlignedBox3d> plane_bounds_m;
@@ -110,6 +112,7 @@ struct CollisionData {
   // current triangle may touch a node of it.
   std::vector<std::uint8_t> sweep_plane_had_contact;
   std::vector<std::uint8_t> sweep_plane_open;
+  std::vector<std::uint64_t> sweep_contact_words;  // bitset over the tool nodes (orders contact_nodes; all 0 between steps)
   // Soft faces.
   std::vector<std::int64_t> face_candidate_stamp;
   std::vector<int> candidate_faces;
