@@ -164,6 +164,7 @@ void allocate_collision_data(const CollisionModel& model, CollisionData& data) {
   data.candidate_nodes.reserve(soft_nodes);
   data.sweep_plane_had_contact.assign(model.tool.planes().size(), 0);
   data.sweep_plane_open.assign(model.tool.planes().size(), 0);
+  data.sweep_contact_words.assign((tool_nodes + 63) / 64, 0);
   data.face_candidate_stamp.assign(soft_faces, -1);
   data.candidate_faces.clear();
   data.candidate_faces.reserve(soft_faces);

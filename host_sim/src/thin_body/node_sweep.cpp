@@ -20,10 +20,19 @@
 // visited cells (the extreme of a plane equation over a box is at a corner): a plane whose nodes all
 // end in front of the triangle, or all start behind it (with none in contact last step, or all
 // beyond the memory depth), is skipped. For a plate pressed face-first into a soft body that skips
-// the far face and the rims — half or more of the nodes under a large triangle.
+// the far face and the rims — half or more of the nodes under a large triangle. The nodes are binned
+// per plane, so a skipped plane's nodes are not even read, and within an open plane each row of
+// cells is cut to the interval where the triangle's end plane can come within contact_distance of
+// a node (the same bound per cell, linear along the row). None of this changes a contact (tests/
+// host_sim/node_sweep_test.cpp compares with the node test applied to every node of the footprint).
+// Measured (bench collision's scaling scene, 128 faces, plate 100 × 2 × 100 mm on a 2 mm grid, held
+// 4 mm deep, 12 contacted triangles): 4618 node tests a step before, 810 after; the stage
+// 18.0 → 7.8 µs.
 #include "collision_state.hpp"
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
 #include <cmath>
 #include <limits>
 
@@ -64,6 +73,31 @@ Triangle make_triangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const
   return t;
 }
 
+// make_triangle in two halves, for the per-node triangle at τ: the barycentric basis (false: a
+// degenerate Gram determinant), then the unit normal (false: a degenerate cross product). Both
+// true ⇔ make_triangle's `valid`, with the same values.
+bool barycentric_basis(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, Triangle& t) {
+  t.a = a;
+  t.b = b;
+  t.c = c;
+  t.e0 = b - a;
+  t.e1 = c - a;
+  t.d00 = t.e0.dot(t.e0);
+  t.d01 = t.e0.dot(t.e1);
+  t.d11 = t.e1.dot(t.e1);
+  const double denominator = t.d00 * t.d11 - t.d01 * t.d01;
+  t.valid = denominator > 0.0;
+  t.inverse_denominator = t.valid ? 1.0 / denominator : 0.0;
+  return t.valid;
+}
+bool unit_normal(Triangle& t, double sign) {
+  const Eigen::Vector3d n = t.e0.cross(t.e1);
+  const double length = n.norm();
+  t.valid = t.valid && length > 1e-18;
+  t.normal = t.valid ? Eigen::Vector3d(sign * n / length) : Eigen::Vector3d::Zero();
+  return t.valid;
+}
+
 bool projects_inside(const Triangle& t, const Eigen::Vector3d& p) {
   const Eigen::Vector3d v2 = p - t.a;
   const double d20 = v2.dot(t.e0);
@@ -86,14 +120,26 @@ double max_over_box(const Eigen::Vector3d& n, double d, const Eigen::AlignedBox3
 void prepare_node_sweep(const ToolNodes& tool, ToolNodeBins& bins) {
   const auto& positions = tool.positions_tool_m();
   const auto& plane_of_node = tool.plane_of_node();
-  bins.positions_m.resize(bins.nodes.size());
-  bins.planes.resize(bins.nodes.size());
-  for (std::size_t b = 0; b < bins.nodes.size(); ++b) {
-    const auto node = static_cast<std::size_t>(bins.nodes[b]);
-    bins.positions_m[b] = positions[node];
-    bins.planes[b] = plane_of_node[node];
+  const std::size_t plane_count = tool.planes().size();
+  const auto cells = static_cast<std::size_t>(bins.cells_u * bins.cells_v);
+  // Each node stays in the cell bins.begin / bins.nodes put it in (edge cells included).
+  std::vector<std::size_t> cell_of_node(positions.size(), 0);
+  for (std::size_t c = 0; c < cells; ++c)
+    for (int b = bins.begin[c]; b < bins.begin[c + 1]; ++b) cell_of_node[static_cast<std::size_t>(bins.nodes[static_cast<std::size_t>(b)])] = c;
+  bins.plane_cell_begin.assign(plane_count * cells + 1, 0);
+  for (std::size_t i = 0; i < positions.size(); ++i)
+    ++bins.plane_cell_begin[static_cast<std::size_t>(plane_of_node[i]) * cells + cell_of_node[i] + 1];
+  for (std::size_t k = 0; k < plane_count * cells; ++k) bins.plane_cell_begin[k + 1] += bins.plane_cell_begin[k];
+  bins.plane_cell_nodes.assign(positions.size(), -1);
+  bins.plane_cell_positions_m.assign(positions.size(), Eigen::Vector3d::Zero());
+  std::vector<int> fill(bins.plane_cell_begin.begin(), bins.plane_cell_begin.end() - 1);
+  for (const int node : bins.nodes) {  // cell order, and the cell's own order inside it
+    const auto i = static_cast<std::size_t>(node);
+    const auto slot = static_cast<std::size_t>(fill[static_cast<std::size_t>(plane_of_node[i]) * cells + cell_of_node[i]]++);
+    bins.plane_cell_nodes[slot] = node;
+    bins.plane_cell_positions_m[slot] = positions[i];
   }
-  bins.plane_bounds_m.assign(tool.planes().size(), Eigen::AlignedBox3d());
+  bins.plane_bounds_m.assign(plane_count, Eigen::AlignedBox3d());
   for (std::size_t i = 0; i < positions.size(); ++i)
     bins.plane_bounds_m[static_cast<std::size_t>(plane_of_node[i])].extend(positions[i]);
 }
@@ -166,47 +212,121 @@ void sweep_tool_nodes(const CollisionModel& model, CollisionData& data) {
       any_open = any_open || open;
     }
     if (!any_open) continue;
-    for (int cu = u0; cu <= u1; ++cu) {
-      for (int cv = v0; cv <= v1; ++cv) {
-        const int cell = cu * bins.cells_v + cv;
-        for (int b = bins.begin[static_cast<std::size_t>(cell)]; b < bins.begin[static_cast<std::size_t>(cell + 1)]; ++b) {
-          const auto bin = static_cast<std::size_t>(b);
-          if (data.sweep_plane_open[static_cast<std::size_t>(bins.planes[bin])] == 0) continue;
-          const Eigen::Vector3d& p = bins.positions_m[bin];
-          const double s_end = end.normal.dot(p - end.a);
-          if (s_end > contact) continue;
-          const int node = bins.nodes[bin];
-          const auto n = static_cast<std::size_t>(node);
-          const double s_start = start.normal.dot(p - start.a);
-          const bool was_in_contact = data.node_face_prev[n] >= 0;
-          if (s_start < -contact && !(was_in_contact && s_start >= -model.memory_depth_m)) continue;
-          const double tau = s_start > contact ? (s_start - contact) / (s_start - s_end) : 1.0;
-          bool inside = false;
-          Eigen::Vector3d normal_at_tau = end.normal;
-          if (tau >= 1.0) {
-            inside = projects_inside(end, p);
-          } else {
-            const Triangle at_tau = make_triangle(start.a + tau * (end.a - start.a), start.b + tau * (end.b - start.b),
-                                                  start.c + tau * (end.c - start.c), sign);
-            inside = at_tau.valid && projects_inside(at_tau, p);
-            normal_at_tau = at_tau.normal;
-          }
-          if (!inside) continue;
-          const bool first = data.node_face[n] < 0;
-          if (first || tau < data.node_tau[n] - 1e-12) {
-            if (first) data.contact_nodes.push_back(node);
-            data.node_face[n] = face;
-            data.node_tau[n] = tau;
-            data.node_facing[n] = normals[n].dot(normal_at_tau);
-          }
+    // Within an open plane, a row of cells (fixed u) is visited only over the cells whose nodes
+    // may end within contact_distance of the triangle's plane (the s_end test below): the lowest
+    // s_end over a cell's node box is linear in the cell's v index, so the cells it keeps are
+    // one interval, solved per row and widened by one cell against the division's rounding (the
+    // box is the cell's extent + kCellSlack_m, the plane's node bounds across u / the thin axis;
+    // edge cells, which also hold the nodes clamped into them, are unbounded outwards). A skipped
+    // cell only holds nodes with s_end > contact + kPlaneSkipSlack_m, which the node test drops:
+    // the contacts are the same, only fewer nodes are read — a triangle tilted against the tool
+    // no longer reads the nodes under the part of its box that its plane passes far above.
+    const int axis_w = 3 - bins.axis_u - bins.axis_v;
+    const double n_u = end.normal[bins.axis_u];
+    const double n_v = end.normal[bins.axis_v];
+    const double n_w = end.normal[axis_w];
+    const double s_end_limit = d_end + contact + kPlaneSkipSlack_m;  // keep a cell while min n·p ≤ this
+    const auto cells_in_plane = static_cast<std::size_t>(bins.cells_u * bins.cells_v);
+    // cv at which n_v·(the cell edge that is lowest along n_v) reaches a budget b: (b − v_offset)·v_scale
+    // (low edge origin_v + cv·cell − slack for n_v > 0, high edge origin_v + (cv + 1)·cell + slack for n_v < 0).
+    const double v_scale = n_v != 0.0 ? 1.0 / (n_v * bins.cell_m) : 0.0;
+    const double v_offset = n_v > 0.0 ? n_v * (bins.origin_v - kCellSlack_m) : n_v * (bins.origin_v + bins.cell_m + kCellSlack_m);
+    const double memory_depth = model.memory_depth_m;
+    // The node test (see the header comment) for the node in plane-major slot b.
+    const auto test_node = [&](int b) {
+      const auto slot = static_cast<std::size_t>(b);
+      const Eigen::Vector3d& p = bins.plane_cell_positions_m[slot];
+      const double s_end = end.normal.dot(p - end.a);
+      if (s_end > contact) return;
+      const int node = bins.plane_cell_nodes[slot];
+      const auto n = static_cast<std::size_t>(node);
+      const double s_start = start.normal.dot(p - start.a);
+      const bool was_in_contact = data.node_face_prev[n] >= 0;
+      if (s_start < -contact && !(was_in_contact && s_start >= -memory_depth)) return;
+      const double tau = s_start > contact ? (s_start - contact) / (s_start - s_end) : 1.0;
+      bool inside = false;
+      Eigen::Vector3d normal_at_tau = end.normal;
+      if (tau >= 1.0) {
+        inside = projects_inside(end, p);
+      } else {
+        // The triangle at τ; its normal (a square root and a division) only once the node is inside.
+        Triangle at_tau;
+        if (barycentric_basis(start.a + tau * (end.a - start.a), start.b + tau * (end.b - start.b),
+                              start.c + tau * (end.c - start.c), at_tau) &&
+            projects_inside(at_tau, p) && unit_normal(at_tau, sign)) {
+          inside = true;
+          normal_at_tau = at_tau.normal;
         }
+      }
+      if (!inside) return;
+      const bool first = data.node_face[n] < 0;
+      if (first || tau < data.node_tau[n] - 1e-12) {
+        if (first) data.contact_nodes.push_back(node);
+        data.node_face[n] = face;
+        data.node_tau[n] = tau;
+        data.node_facing[n] = normals[n].dot(normal_at_tau);
+      }
+    };
+    for (std::size_t plane = 0; plane < plane_count; ++plane) {
+      if (data.sweep_plane_open[plane] == 0) continue;
+      const Eigen::AlignedBox3d& plane_box = bins.plane_bounds_m[plane];
+      const int* cell_begin = &bins.plane_cell_begin[plane * cells_in_plane];
+      const double w_term = n_w > 0.0 ? n_w * plane_box.min()[axis_w] : n_w * plane_box.max()[axis_w];
+      for (int cu = u0; cu <= u1; ++cu) {
+        const int row = cu * bins.cells_v;
+        if (cell_begin[row + v0] == cell_begin[row + v1 + 1]) continue;  // no node of this plane under the row
+        double row_lo = std::max(plane_box.min()[bins.axis_u], cu == 0 ? -kInfinity : bins.origin_u + cu * bins.cell_m - kCellSlack_m);
+        double row_hi = std::min(plane_box.max()[bins.axis_u], cu == bins.cells_u - 1 ? kInfinity : bins.origin_u + (cu + 1) * bins.cell_m + kCellSlack_m);
+        if (row_lo > row_hi) {  // rounding at the plane's edge: take the plane's whole extent
+          row_lo = plane_box.min()[bins.axis_u];
+          row_hi = plane_box.max()[bins.axis_u];
+        }
+        const double u_term = n_u > 0.0 ? n_u * row_lo : n_u * row_hi;
+        // Keep cell cv while u_term + w_term + (lowest n_v·v over the cell) ≤ s_end_limit.
+        const double v_budget = s_end_limit - u_term - w_term;
+        int first = v0;
+        int last = v1;
+        int edge_cell = -1;  // an edge cell outside first..last that must still be visited
+        if (n_v > 0.0) {
+          // Lowest n_v·v at the cell's low edge origin_v + cv·cell − slack: keep cv ≤ cv_max (+1 cell;
+          // truncation is the floor here: cv_max ≥ v0 ≥ 0).
+          const double cv_max = (v_budget - v_offset) * v_scale + 1.0;
+          if (cv_max < static_cast<double>(v1)) last = cv_max < static_cast<double>(v0) ? v0 - 1 : static_cast<int>(cv_max);
+          // Cell 0 also holds the nodes clamped into it from below (unbounded): always kept.
+          if (v0 == 0 && last < 0) edge_cell = 0;
+        } else if (n_v < 0.0) {
+          // Lowest n_v·v at the cell's high edge origin_v + (cv + 1)·cell + slack: keep cv ≥ cv_min (−1 cell;
+          // truncation is at most the ceiling: one more cell at worst).
+          const double cv_min = (v_budget - v_offset) * v_scale - 1.0;
+          if (cv_min > static_cast<double>(v0)) first = cv_min > static_cast<double>(v1) ? v1 + 1 : static_cast<int>(cv_min);
+          // The last cell also holds the nodes clamped into it from above (unbounded): always kept.
+          if (v1 == bins.cells_v - 1 && first > v1) edge_cell = v1;
+        } else if (v_budget < 0.0) {
+          continue;  // the plane's lowest s_end over the whole row is above the contact distance
+        }
+        if (edge_cell >= 0) first = last = edge_cell;
+        // Cells first..last of a row: one contiguous run of this plane's nodes.
+        for (int b = cell_begin[row + first]; b < cell_begin[row + last + 1]; ++b) test_node(b);
       }
     }
   }
-  std::sort(data.contact_nodes.begin(), data.contact_nodes.end());  // deterministic order
-  // Side memory: how many consecutive steps each node has been in contact.
-  for (std::size_t i = 0; i < data.node_face.size(); ++i)
-    data.node_age[i] = data.node_face[i] >= 0 ? (data.node_face_prev[i] >= 0 ? data.node_age[i] + 1 : 1) : 0;
+  // Deterministic order: node index order, through a bitset of the tool nodes (linear in the tool
+  // nodes / 64 plus the contacts, where sorting a deep press's hundreds of contact nodes cost ~6 %).
+  for (const int node : data.contact_nodes)
+    data.sweep_contact_words[static_cast<std::size_t>(node) >> 6U] |= std::uint64_t{1} << (static_cast<unsigned>(node) & 63U);
+  data.contact_nodes.clear();
+  for (std::size_t word = 0; word < data.sweep_contact_words.size(); ++word) {
+    for (std::uint64_t bits = data.sweep_contact_words[word]; bits != 0; bits &= bits - 1)
+      data.contact_nodes.push_back(static_cast<int>(64 * word) + std::countr_zero(bits));
+    data.sweep_contact_words[word] = 0;
+  }
+  // Side memory: how many consecutive steps each node has been in contact. Kept for the nodes in
+  // contact only (the pair rule reads the age of nodes in contact, and a node's count restarts at
+  // 1 when it was not in contact last step), not over every tool node each step.
+  for (const int node : data.contact_nodes) {
+    const auto i = static_cast<std::size_t>(node);
+    data.node_age[i] = data.node_face_prev[i] >= 0 ? data.node_age[i] + 1 : 1;
+  }
 }
 
 }  // namespace fissure::host::thin_body
