@@ -75,6 +75,24 @@ void update_device_faults(const RtModel& model, RtData& data, std::uint32_t new_
   }
 }
 
+// The position epoch (messages.hpp). A rejected sample leaves the published position where the
+// last accepted one put it; the next accepted sample may be anywhere — a jumped encoder reading
+// now accepted as lost counts, the hand's unobserved motion during an I/O fault, a cold FK
+// restart — so it opens a new epoch, and the host re-seats its tool there instead of sweeping
+// it through the soft body. The first accepted sample opens epoch 1. A non-finite force found
+// after the sample was accepted (tick(), step 4) does not: that sample was published, and the
+// next one is judged against it by the jump check, so the published position stays continuous.
+void update_position_epoch(RtData& data, std::uint32_t sample_faults) noexcept {
+  if (sample_faults != 0) {
+    data.position_continuous = false;
+    return;
+  }
+  if (!data.position_continuous) {
+    data.position_epoch = next_position_epoch(data.position_epoch);
+    data.position_continuous = true;
+  }
+}
+
 std::uint32_t to_device_status(const RtData& data, std::uint32_t fault_bits) noexcept {
   std::uint32_t status = 0;
   if ((data.reading.homed_mask & 0x7u) == 0x7u) status |= kDeviceHomed;
@@ -99,6 +117,7 @@ TickResult tick(const RtModel& model, RtData& data, TickIo& io, const TickTiming
   // 1. read device … velocity
   const std::uint32_t sample_faults = read_device(model, data, io.device, now_ns);
   data.have_position = sample_faults == 0;
+  update_position_epoch(data, sample_faults);
   if (data.have_position) observe_energy(data.passivity, data.p_device_m);
   update_device_faults(model, data, sample_faults);
 
@@ -186,7 +205,7 @@ TickResult tick(const RtModel& model, RtData& data, TickIo& io, const TickTiming
   state.velocity_device_m_per_s = to_vec3(data.v_device_m_per_s);
   state.closing_axis_m = jaw_closing_m(config.mapping, data.p_device_m);
   state.buttons = data.reading.buttons;
-  state.status_flags = to_device_status(data, flags);
+  state.status_flags = with_position_epoch(to_device_status(data, flags), data.position_epoch);
   io.state_out.publish(state);
 
   TelemetrySample sample;

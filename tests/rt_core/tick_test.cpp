@@ -385,5 +385,112 @@ TEST(Tick, ClampModeRendersTheGripOnTheClosingAxis) {
   EXPECT_NEAR(result.force_device_n.z(), 0.0, 1e-12);
 }
 
+// ---- position epoch (messages.hpp: DeviceState::status_flags bits 24..31) ----------------------
+
+// The newest DeviceState the tick published (the exchange keeps only the newest).
+DeviceState published(Harness& h) {
+  DeviceState state;
+  EXPECT_TRUE(h.state_out.try_fetch(state));
+  return state;
+}
+
+Eigen::Vector3d position_of(const DeviceState& state) { return as_eigen(state.position_device_m); }
+
+TEST(Tick, FirstAcceptedSampleOpensEpochOneAndContinuousSamplesKeepIt) {
+  Harness h;
+  h.device.status = falcon::IoStatus::kTimeout;  // no reading yet: nothing accepted
+  h.step();
+  EXPECT_EQ(position_epoch(published(h).status_flags), 0u) << "0: position_device_m is not a reading yet";
+  h.device.status = falcon::IoStatus::kOk;
+  h.step();
+  EXPECT_EQ(position_epoch(published(h).status_flags), 1u);
+  for (int i = 0; i < 200; ++i) {
+    h.publish(kStiffness_n_per_m);
+    h.step();
+    ASSERT_EQ(position_epoch(published(h).status_flags), 1u) << "tick " << i;
+  }
+}
+
+// The stress case encoder_jumps: rt_core accepts a jumped reading as lost counts, so the
+// published position steps by centimetres on a tick the host cannot tell from motion by its
+// fault bits (they stay latched for recovery_ticks either side). The epoch marks exactly the
+// first accepted sample after the rejected one, and nothing after it.
+TEST(Tick, AcceptedEncoderJumpOpensANewEpochOnItsFirstSampleOnly) {
+  Harness h;
+  h.settle();
+  const DeviceState before = published(h);
+  const std::uint8_t epoch = position_epoch(before.status_flags);
+  ASSERT_EQ(epoch, 1u);
+  h.device.counts[0] = static_cast<std::int16_t>(h.device.counts[0] + 1500);  // a lost-count burst
+  h.publish(kStiffness_n_per_m);
+  ASSERT_NE(h.step().fault_bits & kFaultEncoderJump, 0u);
+  const DeviceState rejected = published(h);
+  EXPECT_EQ(position_epoch(rejected.status_flags), epoch) << "the rejected sample is not published: nothing moved";
+  EXPECT_EQ(position_of(rejected), position_of(before));
+
+  h.publish(kStiffness_n_per_m);
+  h.step();  // judged against the jumped reading: accepted
+  const DeviceState jumped = published(h);
+  EXPECT_EQ(position_epoch(jumped.status_flags), epoch + 1);
+  EXPECT_GT((position_of(jumped) - position_of(before)).norm(), 0.01) << "the published position stepped";
+  EXPECT_NE(jumped.status_flags & kDeviceFaultEncoderJump, 0u) << "still latched: recovery not done";
+  DeviceState after;
+  for (int i = 0; i < 3 * h.model.config.faults.recovery_ticks; ++i) {
+    h.publish(kStiffness_n_per_m);
+    h.step();
+    after = published(h);
+    ASSERT_EQ(position_epoch(after.status_flags), epoch + 1) << "tick " << i << " after the jump";
+  }
+  EXPECT_EQ(after.status_flags & kDeviceFaultMask, 0u) << "recovered";
+  EXPECT_EQ(position_of(after), position_of(jumped)) << "continuous from the jumped sample on (the device holds still)";
+}
+
+TEST(Tick, DeviceIoFaultAndRecoveryOpenANewEpoch) {
+  Harness h;
+  h.settle();
+  std::uint8_t epoch = position_epoch(published(h).status_flags);
+  for (const falcon::IoStatus status :
+       {falcon::IoStatus::kTimeout, falcon::IoStatus::kTornPacket, falcon::IoStatus::kNotRunning}) {
+    h.device.status = status;
+    for (int i = 0; i < 3; ++i) {
+      h.step();
+      ASSERT_EQ(position_epoch(published(h).status_flags), epoch) << "held position during the fault";
+    }
+    h.device.status = falcon::IoStatus::kOk;
+    h.step();
+    ASSERT_EQ(position_epoch(published(h).status_flags), next_position_epoch(epoch));
+    epoch = next_position_epoch(epoch);
+    for (int i = 0; i < 50; ++i) h.step();
+    ASSERT_EQ(position_epoch(published(h).status_flags), epoch);
+  }
+}
+
+TEST(Tick, KinematicsFailureOpensANewEpochWhenASampleIsAcceptedAgain) {
+  Harness h;
+  h.settle();
+  const std::uint8_t epoch = position_epoch(published(h).status_flags);
+  h.device.counts = {10000, 10000, 10000};  // unreachable: jump, then FK fails
+  for (int i = 0; i < 5; ++i) {
+    h.step();
+    ASSERT_EQ(position_epoch(published(h).status_flags), epoch);
+  }
+  h.device.place(kCentre_device_m);
+  h.step();  // an encoder jump back: rejected
+  ASSERT_EQ(position_epoch(published(h).status_flags), epoch);
+  h.step();
+  EXPECT_EQ(position_epoch(published(h).status_flags), next_position_epoch(epoch));
+}
+
+TEST(Tick, PositionEpochWrapsPastZero) {
+  Harness h;
+  h.step();
+  h.data.position_epoch = 0xFF;  // as after 255 discontinuities
+  h.device.status = falcon::IoStatus::kTimeout;
+  h.step();
+  h.device.status = falcon::IoStatus::kOk;
+  h.step();
+  EXPECT_EQ(position_epoch(published(h).status_flags), 1u);
+}
+
 }  // namespace
 }  // namespace fissure::rt

@@ -49,6 +49,36 @@ TEST(WireCodec, DeviceStateIsOneFullFdFrameAndRoundTrips) {
   }
 }
 
+// The position epoch rides in status_flags bits 24..31 (messages.hpp): the codec must carry
+// them whole and the reassembler must not take them for anything it rejects, or a host behind a
+// link would never see rt_core's discontinuities and would sweep its tool along them.
+TEST(WireCodec, DeviceStateCarriesThePositionEpochAndTheFaultBitsBesideIt) {
+  for (const std::uint8_t epoch : {std::uint8_t{1}, std::uint8_t{0x80}, std::uint8_t{0xFF}}) {
+    DeviceState sent = make_device_state(7 + epoch);
+    sent.status_flags = with_position_epoch(kDeviceHomed | kDeviceFaultEncoderJump, epoch);
+    FrameBatch batch;
+    ASSERT_EQ(encode(sent, 1, batch), EncodeStatus::kOk);
+    Reassembler reassembler;
+    ASSERT_EQ(deliver(reassembler, batch), MessageType::kDeviceState) << "epoch " << int{epoch};
+    const DeviceState& got = reassembler.device_state();
+    EXPECT_EQ(position_epoch(got.status_flags), epoch);
+    EXPECT_EQ(got.status_flags & kDeviceFaultMask, static_cast<std::uint32_t>(kDeviceFaultEncoderJump));
+    EXPECT_NE(got.status_flags & kDeviceHomed, 0u);
+  }
+}
+
+TEST(WireCodec, PositionEpochHelpersKeepTheOtherBitsAndSkipZeroOnWrap) {
+  const std::uint32_t flags = kDeviceHomed | kDeviceSimulated | kDeviceFaultTimeout;
+  EXPECT_EQ(position_epoch(flags), 0u);
+  const std::uint32_t with = with_position_epoch(flags, 0xA5);
+  EXPECT_EQ(position_epoch(with), 0xA5u);
+  EXPECT_EQ(with & ~kDevicePositionEpochMask, flags);
+  EXPECT_EQ(with_position_epoch(with, 3) & ~kDevicePositionEpochMask, flags);
+  EXPECT_EQ(next_position_epoch(0), 1u);
+  EXPECT_EQ(next_position_epoch(41), 42u);
+  EXPECT_EQ(next_position_epoch(0xFF), 1u) << "0 means no accepted sample: never reached by wrapping";
+}
+
 TEST(WireCodec, FullProxyTakesTenFramesAndRoundTrips) {
   const ContactProxy sent = make_proxy(1234, kMaxContactPatches);
   FrameBatch batch;

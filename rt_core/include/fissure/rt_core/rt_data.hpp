@@ -46,6 +46,10 @@ struct RtData {
   Eigen::Vector3d p_device_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d v_device_m_per_s = Eigen::Vector3d::Zero();
   bool have_position = false;               ///< p_device_m came from a good sample this tick
+  // Position epoch (messages.hpp, DeviceState::status_flags bits 24..31): advanced at the first
+  // accepted sample after one or more rejected ones, and at the very first accepted sample.
+  std::uint8_t position_epoch = 0;          ///< epoch of the position published (0: no sample accepted yet)
+  bool position_continuous = false;         ///< the next accepted sample continues the published position
   // mapping, proxy, HC, blend, fade
   ToolState tool{};
   ProxyState proxy{};

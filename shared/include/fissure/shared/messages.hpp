@@ -22,7 +22,8 @@ namespace fissure {
 
 /// Version of the layouts below and of the wire codec built on them. The transport
 /// handshake refuses a peer with a different version (naming both).
-inline constexpr std::uint16_t kProtocolVersion = 1;
+/// 2: DeviceState::status_flags bits 24..31 carry the position epoch (below).
+inline constexpr std::uint16_t kProtocolVersion = 2;
 
 /// One patch per tool face or jaw is enough for the paper's tools (spatula: 2 faces,
 /// clamp: 2 jaws × 2 faces); 8 leaves room for a convex tool's rim.
@@ -47,6 +48,39 @@ enum DeviceStatusBits : std::uint32_t {
   kDeviceFaultMask = 0xFFFFu << 8,
 };
 
+/// Bits 24..31 of DeviceState::status_flags: the *position epoch*, a counter rt_core advances
+/// each time the position it publishes is not continuous with the one it published before —
+/// the first accepted sample after rejected ones (an encoder jump, a non-finite sample, an I/O
+/// fault or timeout) and the very first sample. Why: after an encoder jump rt_core accepts the
+/// jumped reading as the new truth (lost counts cannot be told from a re-home until the next
+/// homing), so position_device_m may step by centimetres between two samples, on a tick whose
+/// fault bits the host cannot rely on seeing. That step is not motion of the hand; a host that
+/// swept its tool along it would drag the soft body through itself (the stress case
+/// encoder_jumps turned the ball inside out). A host re-seats its tool, without sweeping, when
+/// the epoch differs from the last one it applied. A counter, not a one-tick flag, so that a
+/// lost or reordered DeviceState (UDP/CAN at 50 % loss) cannot hide the discontinuity: any later
+/// sample still carries the new value. Epoch 0 = no accepted sample yet (position_device_m is
+/// not a reading); it wraps 255 → 1, so only 255 discontinuities between two samples the host
+/// receives could alias. It sits in status bits no flag uses (kDeviceFaultMask is 8..23), so the
+/// struct's layout and the wire codec (which carries status_flags whole) are unchanged.
+inline constexpr unsigned kDevicePositionEpochShift = 24;
+inline constexpr std::uint32_t kDevicePositionEpochMask = 0xFFu << kDevicePositionEpochShift;
+
+/// The position epoch carried in `status_flags` (0: no accepted sample yet).
+constexpr std::uint8_t position_epoch(std::uint32_t status_flags) noexcept {
+  return static_cast<std::uint8_t>((status_flags & kDevicePositionEpochMask) >> kDevicePositionEpochShift);
+}
+/// `status_flags` with its epoch bits replaced by `epoch`.
+constexpr std::uint32_t with_position_epoch(std::uint32_t status_flags, std::uint8_t epoch) noexcept {
+  return (status_flags & ~kDevicePositionEpochMask) | (static_cast<std::uint32_t>(epoch) << kDevicePositionEpochShift);
+}
+/// The epoch after `epoch`: 1 … 255, then 1 again (0 is reserved for "no accepted sample").
+constexpr std::uint8_t next_position_epoch(std::uint8_t epoch) noexcept {
+  return epoch == 0xFFu ? std::uint8_t{1} : static_cast<std::uint8_t>(epoch + 1u);
+}
+static_assert((kDevicePositionEpochMask & kDeviceFaultMask) == 0u, "the epoch must not overlap a fault bit");
+static_assert(next_position_epoch(0xFFu) == 1u && next_position_epoch(0u) == 1u);
+
 /// One sample of the haptic device as rt_core saw it (rt_core → host_sim, and telemetry).
 struct DeviceState {
   std::uint64_t sequence = 0;        ///< +1 per published sample; gaps mean lost samples
@@ -55,7 +89,7 @@ struct DeviceState {
   Vec3 velocity_device_m_per_s{};    ///< filtered end-effector velocity, device frame [m/s]
   double closing_axis_m = 0.0;       ///< clamp mode: displacement along the mapped closing axis [m]
   std::uint32_t buttons = 0;         ///< bit i = grip button i pressed (Falcon: 4 buttons)
-  std::uint32_t status_flags = 0;    ///< DeviceStatusBits
+  std::uint32_t status_flags = 0;    ///< DeviceStatusBits; bits 24..31: position epoch (position_epoch())
 };
 static_assert(std::is_trivially_copyable_v<DeviceState>);
 static_assert(sizeof(DeviceState) == 80);
