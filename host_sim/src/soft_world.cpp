@@ -214,6 +214,20 @@ void SoftWorld::set_part_pose(int part, const ToolPose& pose) noexcept {
   if (!parts_in_world_) body.setWorldTransform(bt(pose));  // not stepped by the world
 }
 
+void SoftWorld::teleport_part(int part, const ToolPose& pose) noexcept {
+  btRigidBody& body = *parts_[static_cast<std::size_t>(part)];
+  const btTransform transform = bt(pose);
+  body.getMotionState()->setWorldTransform(transform);
+  body.setWorldTransform(transform);
+  // A kinematic body's velocity for the next step is (motion-state pose − this pose) / dt
+  // (btRigidBody::saveKinematicState): both at the new pose, it starts from rest.
+  body.setInterpolationWorldTransform(transform);
+  body.setLinearVelocity(btVector3(0, 0, 0));
+  body.setAngularVelocity(btVector3(0, 0, 0));
+  body.setInterpolationLinearVelocity(btVector3(0, 0, 0));
+  body.setInterpolationAngularVelocity(btVector3(0, 0, 0));
+}
+
 void SoftWorld::step(double h_s) noexcept {
   if (probe_ != nullptr) probe_->clear();
   const auto h = static_cast<btScalar>(h_s);

@@ -70,6 +70,10 @@ class SoftWorld {
 
   /// Places a tool part (kinematic: Bullet derives its velocity from the previous pose).
   void set_part_pose(int part, const ToolPose& pose) noexcept;
+  /// Places a tool part with no motion from its previous pose: Bullet derives zero velocity
+  /// for the next step (HostSimulation::reseat_tool; a kinematic body moved by set_part_pose
+  /// would carry jump / dt into its contacts with the soft body).
+  void teleport_part(int part, const ToolPose& pose) noexcept;
   /// One Bullet step of h seconds (exactly one internal substep).
   void step(double h_s) noexcept;
   /// Copies the soft nodes' positions (world, metres) into `out` (resized once).
