@@ -128,6 +128,26 @@ void HostSimulation::settle(double seconds) {
   for (int p = 0; p < world_->part_count(); ++p) trackers_[static_cast<std::size_t>(p)].reset(nodes_, to_isometry(part_poses_[static_cast<std::size_t>(p)]));
 }
 
+int HostSimulation::reseat_tool(const ToolPose& tool_pose, double jaw_gap_m) {
+  const bool clamp = scene_.tool.kind == ToolKind::kClamp;
+  const std::array<ToolPose, kMaxToolParts> previous = part_poses_;
+  tool_pose_ = tool_pose;
+  jaw_gap_m_ = clamp ? std::clamp(jaw_gap_m, scene_.tool.clamp.jaw_gap_min_m, scene_.tool.clamp.jaw_gap_open_m) : 0.0;
+  tool_part_poses(scene_, tool_pose_, jaw_gap_m_, part_poses_);
+  int put_out = 0;
+  for (int p = 0; p < world_->part_count(); ++p) {
+    const auto k = static_cast<std::size_t>(p);
+    world_->teleport_part(p, part_poses_[k]);
+    put_out += collisions_[k]->reseat(previous[k], part_poses_[k], world_->soft());
+  }
+  // The crossing metric judges each node's relative path between two updates: from the old pose
+  // to the new one every node in between would count as "through". A re-seat is not a path; the
+  // sides are taken afresh here (after the nodes inside were put out), as after settle().
+  world_->copy_node_positions(nodes_);
+  for (int p = 0; p < world_->part_count(); ++p) trackers_[static_cast<std::size_t>(p)].reset(nodes_, to_isometry(part_poses_[static_cast<std::size_t>(p)]));
+  return put_out;
+}
+
 const HostStepResult& HostSimulation::step(const ToolPose& tool_target, double jaw_gap_m) {
   const Clock::time_point start = Clock::now();
   const int parts = world_->part_count();

@@ -9,6 +9,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <stdexcept>
 
 namespace fissure::host {
@@ -18,6 +20,9 @@ ThinBodyCollision::~ThinBodyCollision() = default;
 namespace {
 
 using Clock = std::chrono::steady_clock;
+// A node counts as inside the tool beyond this depth (float noise of positions written at +skin;
+// enforced_displacement.cpp's tolerance).
+constexpr double kInsideTolerance_m = 1e-7;
 double seconds_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
 class ThinBodyCollisionImpl final : public ThinBodyCollision {
@@ -81,11 +86,71 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision {
     thin_body::take_rest_state(soft, model_.soft);
   }
 
+  int reseat(const ToolPose& previous, const ToolPose& current, btSoftBody& soft) override {
+    if (&soft != soft_) throw std::invalid_argument("thin-body collision: reseat() got a different soft body");
+    // Every per-step memory back to how the constructor left it (assign() on vectors of the same
+    // size: nothing is allocated). The step counter continues, so the stamps allocate does not
+    // touch (the broad phase's own) stay older than every step to come, and every stamp it reset
+    // (-1) is older than "last step": held nodes, tool-node contacts, ẋ filters all start afresh.
+    const std::int64_t step = data_.step;
+    thin_body::allocate_collision_data(model_, data_);
+    data_.step = step;
+    had_contact_ = false;
+    return put_out_nodes_inside(previous, current, soft);
+  }
+
   [[nodiscard]] CollisionMethod method() const override {
     return model_.paired ? CollisionMethod::kPaired : CollisionMethod::kRay;
   }
 
  private:
+  // reseat(): every free soft node inside the tool at `current` onto a face + skin (see the
+  // interface for which face and why).
+  int put_out_nodes_inside(const ToolPose& previous, const ToolPose& current, btSoftBody& soft) const {
+    const Eigen::Matrix3d r_cur = current.orientation_world.toRotationMatrix();
+    const Eigen::Matrix3d r_prev = previous.orientation_world.toRotationMatrix();
+    const auto& planes = model_.tool.planes();
+    const double skin_m = model_.params.skin_m;
+    // A face further away than the tool is thick is not a way out of a thin tool: it is its rim
+    // seen from the middle of a face (up to half the tool's width away).
+    const double reach_m = model_.tool.thickness_m() + skin_m;
+    int put_out = 0;
+    for (int i = 0; i < soft.m_nodes.size(); ++i) {
+      btSoftBody::Node& node = soft.m_nodes[i];
+      if (node.m_im == 0) continue;  // fixed nodes are never moved (enforced_displacement.cpp)
+      const Eigen::Vector3d x_world(node.m_x.x(), node.m_x.y(), node.m_x.z());
+      Eigen::Vector3d p_cur = r_cur.transpose() * (x_world - current.position_world_m);
+      double depth_m = -std::numeric_limits<double>::infinity();  // signed distance to the tool, < 0 inside
+      int nearest = 0;
+      for (std::size_t q = 0; q < planes.size(); ++q) {
+        const double d = planes[q].normal_tool.dot(p_cur) - planes[q].offset_m;
+        if (d > depth_m) {
+          depth_m = d;
+          nearest = static_cast<int>(q);
+        }
+      }
+      if (depth_m >= -kInsideTolerance_m) continue;
+      const Eigen::Vector3d p_prev = r_prev.transpose() * (x_world - previous.position_world_m);
+      int exit = nearest;
+      double best_in_front_m = -std::numeric_limits<double>::infinity();
+      for (std::size_t q = 0; q < planes.size(); ++q) {
+        if (planes[q].offset_m - planes[q].normal_tool.dot(p_cur) > reach_m) continue;
+        const double in_front_m = planes[q].normal_tool.dot(p_prev) - planes[q].offset_m;
+        if (in_front_m > best_in_front_m) {
+          best_in_front_m = in_front_m;
+          exit = static_cast<int>(q);
+        }
+      }
+      const ToolPlane& plane = planes[static_cast<std::size_t>(exit)];
+      p_cur += (plane.offset_m + skin_m - plane.normal_tool.dot(p_cur)) * plane.normal_tool;
+      const Eigen::Vector3d out_world = r_cur * p_cur + current.position_world_m;
+      node.m_x.setValue(static_cast<btScalar>(out_world.x()), static_cast<btScalar>(out_world.y()),
+                        static_cast<btScalar>(out_world.z()));
+      ++put_out;
+    }
+    return put_out;
+  }
+
   thin_body::CollisionModel model_;
   thin_body::CollisionData data_;
   thin_body::StepFrame frame_;

@@ -72,6 +72,9 @@ class BulletCollision final : public ThinBodyCollision {
   BulletCollision(const ContactProbeSolver& probe, const btCollisionObject& part_object, int part);
   void step(const ToolPose& previous, const ToolPose& current, double dt_s, btSoftBody& soft, CollisionStepResult& out) override;
   void reset_rest_state(const btSoftBody& soft) override;
+  /// Nothing to forget and nothing to put out here: Bullet finds its soft-rigid contacts afresh
+  /// each step (SDF_RS), and its contact pushes out nodes inside the part along the SDF gradient.
+  int reseat(const ToolPose& /*previous*/, const ToolPose& /*current*/, btSoftBody& /*soft*/) override { return 0; }
   [[nodiscard]] CollisionMethod method() const override { return CollisionMethod::kBullet; }
 
  private:

@@ -61,6 +61,18 @@ class HostSimulation {
   /// used by clamp scenes only (clamped to [jaw_gap_min, jaw_gap_open]).
   const HostStepResult& step(const ToolPose& tool_target, double jaw_gap_m = 0.0);
 
+  /// Re-seats the tool at `tool_pose` (and jaw_gap_m, as step() takes it) without moving it
+  /// through the space between: for a pose that is not reached by motion — rt_core's position
+  /// epoch changed (messages.hpp: an accepted encoder jump, the first sample after a device
+  /// fault). step() sweeps the tool from its pose to the target (no tunnelling at any speed, by
+  /// design), which carries every node it sweeps: a 10 cm jump would drag the soft body through
+  /// itself. Here no time passes: the parts are placed with zero velocity, the collision forgets
+  /// its contact memory and puts soft nodes that lie inside the tool at the new pose out onto a
+  /// face (ThinBodyCollision::reseat says which; bullet: its own contact does, next step), and
+  /// the crossing metric takes every node's side afresh. The next step(tool_pose) starts from rest
+  /// at the new pose. Returns the number of soft nodes put out of the tool.
+  int reseat_tool(const ToolPose& tool_pose, double jaw_gap_m = 0.0);
+
   /// The scripted trajectory's target at the current time (for `fissure sim`).
   [[nodiscard]] TrajectorySample scripted_target() const noexcept;
 

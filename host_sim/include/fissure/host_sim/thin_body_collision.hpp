@@ -179,6 +179,19 @@ class ThinBodyCollision {
   // Re-take the rest state (rest centroids for x) from the body's current positions, e.g. after
   // letting it settle under gravity, so that x = 0 at the settled shape.
   virtual void reset_rest_state(const btSoftBody& soft) = 0;
+  // The tool was re-seated (HostSimulation::reseat_tool) from `previous` to `current` without
+  // moving through the space between (a position rt_core marked as not continuous: an accepted
+  // encoder jump, the first sample after a device fault). Nothing of the previous pose may act on
+  // the next step, so this forgets the tool nodes' contacts, the soft nodes' side memory (held on
+  // which face, where) and the ẋ filters — kept, a node held on a face before the re-seat is put
+  // back on that face at the new pose, from wherever it now is. And it puts every free soft node
+  // that lies inside the tool at `current` out onto a face (+ skin_m), so that the step after
+  // starts with none inside: of the faces at most a tool thickness away, the one the node was
+  // furthest in front of at `previous` — for a short re-seat (the hand moved on during a few
+  // dropped replies) the side it was really on, where a sweep would have put it too; the
+  // nearest face would put a node the tool advanced past its mid-plane on the far side, through
+  // the tool. Returns the number of nodes put out. Does not allocate.
+  virtual int reseat(const ToolPose& previous, const ToolPose& current, btSoftBody& soft) = 0;
   [[nodiscard]] virtual CollisionMethod method() const = 0;
 };
 
