@@ -4,7 +4,10 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
+
+#include <BulletSoftBody/btSoftBody.h>
 
 #include "fissure/host_sim/soft_world.hpp"
 #include "fissure/rt_core/device_mapping.hpp"
@@ -52,17 +55,25 @@ SessionHost::SessionHost(const host::SceneDescription& scene)
     : scene_(scene), sim_(scene), builder_(proxy_model_for(scene, sim_)) {
   pose_.position_world_m = as_eigen(scene.trajectory.start.position_world_m);
   pose_.orientation_world = to_quaternion(scene.trajectory.start.orientation_world);
+  settled_volume_m3_ = sim_.world().soft().getVolume();
 }
 
-void SessionHost::settle(double seconds) { sim_.settle(seconds); }
+void SessionHost::settle(double seconds) {
+  sim_.settle(seconds);
+  settled_volume_m3_ = sim_.world().soft().getVolume();
+}
 
 const HostStatus& SessionHost::step(rt::DeviceStateExchange& state_in, rt::ProxyExchange& proxy_out) {
   const auto start = std::chrono::steady_clock::now();
   DeviceState incoming;
+  bool rt_restarted = false;
   if (state_in.try_fetch(incoming)) {
     // A non-finite sample (a corrupt link, a broken device) would turn Bullet's soft body to
     // NaN for good: keep the tool at the last finite sample and count the rejection.
     if (is_finite(incoming)) {
+      // Sequences only grow within one rt_core run: a smaller one is a restarted rt_core, whose
+      // epochs start again and may equal the one applied last.
+      rt_restarted = have_device_ && incoming.sequence < device_.sequence;
       device_ = incoming;
       have_device_ = true;
     } else {
@@ -70,11 +81,13 @@ const HostStatus& SessionHost::step(rt::DeviceStateExchange& state_in, rt::Proxy
     }
   }
   const DeviceMapping& mapping = scene_.device_mapping;
+  // Epoch 0: rt_core has accepted no reading yet, its position is not one (messages.hpp).
+  const std::uint8_t epoch = have_device_ ? position_epoch(device_.status_flags) : std::uint8_t{0};
   rt::ToolState tool;
-  if (have_device_) {
+  if (epoch != 0) {
     tool = rt::device_to_tool(mapping, as_eigen(device_.position_device_m), as_eigen(device_.velocity_device_m_per_s));
   } else {
-    // Before rt_core's first sample: hold the tool where the scene starts it.
+    // Before rt_core's first accepted sample: hold the tool where it is (the scene's start pose).
     tool.p_tool_world_m = pose_.position_world_m;
     tool.jaw_closing_m = 0.0;
   }
@@ -82,6 +95,18 @@ const HostStatus& SessionHost::step(rt::DeviceStateExchange& state_in, rt::Proxy
   // rt_core's jaws close by scale·closing in total (each moves scale·closing/2), so the gap is
   // the open gap less that.
   const double jaw_gap_m = scene_.tool.clamp.jaw_gap_open_m - mapping.scale * tool.jaw_closing_m;
+  if (epoch != applied_epoch_ || rt_restarted) {
+    // rt_core says this position does not continue the last one (an accepted encoder jump, the
+    // first sample after a device fault, its first sample): the hand did not move the tool
+    // there. Sweeping to it would carry every soft node on the way (10 cm through the ball and
+    // back in the stress case encoder_jumps, which turned it inside out): re-seat the tool. The
+    // step below then starts from rest at the new pose, so its tool velocity is 0, not jump / dt.
+    if (epoch != 0) {
+      sim_.reseat_tool(pose_, jaw_gap_m);
+      ++status_.tool_reseats;
+    }
+    applied_epoch_ = epoch;
+  }
   const host::HostStepResult& result = sim_.step(pose_, jaw_gap_m);
 
   host::ProxyPartMotion parts;
@@ -103,6 +128,11 @@ const HostStatus& SessionHost::step(rt::DeviceStateExchange& state_in, rt::Proxy
   status_.force_n = result.force_on_tool_world_n.norm();
   status_.jaw_gap_m = result.jaw_gap_m;
   status_.proxy_sequence = proxy_.sequence;
+  // A closed surface's signed volume (O(faces), cheap beside the step) goes below 0 when the body
+  // is turned inside out; the one-sided collision then meets no triangle and contact silently stops.
+  status_.soft_volume_ratio = settled_volume_m3_ != 0.0 ? sim_.world().soft().getVolume() / settled_volume_m3_
+                                                        : std::numeric_limits<double>::quiet_NaN();
+  status_.soft_everted = status_.soft_everted || status_.soft_volume_ratio < 0.0;
   status_.step_cpu_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return status_;
 }

@@ -29,6 +29,11 @@ struct HostStatus {
   double jaw_gap_m = 0.0;             ///< clamp: gap the host applied
   std::uint64_t proxy_sequence = 0;
   std::uint64_t rejected_device_states = 0;  ///< non-finite samples dropped before the scene
+  std::uint64_t tool_reseats = 0;     ///< device position epoch changes: tool re-seated, not swept
+  /// Soft body's signed enclosed volume / its volume when settled (1 at rest; < 0: more of its
+  /// surface faces inwards than outwards — turned inside out; meaningful for a closed surface only).
+  double soft_volume_ratio = 1.0;
+  bool soft_everted = false;          ///< soft_volume_ratio < 0 after some step so far (latched)
 };
 
 /// The proxy builder's model for a scene's host simulation (planes per jaw, jaw → rt part).
@@ -59,6 +64,10 @@ class SessionHost {
   host::ToolPose pose_;
   DeviceState device_{};
   bool have_device_ = false;
+  /// The device position epoch the tool pose follows (messages.hpp; 0: none yet — the tool
+  /// stays at the scene's start pose until rt_core has accepted a sample).
+  std::uint8_t applied_epoch_ = 0;
+  double settled_volume_m3_ = 0.0;    ///< soft body's enclosed volume at construction / after settle()
   ContactProxy proxy_{};
   HostStatus status_{};
 };
