@@ -27,6 +27,19 @@ double forgiven_j(const PassivityState& state, double margin_j) noexcept {
   return std::min(owed_j, std::max(0.0, state.energy_j + margin_j));
 }
 
+/// The force as the device renders it: clamped to max_force_n, direction kept (what safety's
+/// clamp makes of it afterwards; the controller must act on this, not on a force never sent).
+Eigen::Vector3d renderable(const Eigen::Vector3d& force_n, double max_force_n) noexcept {
+  const double magnitude = force_n.norm();
+  return magnitude > max_force_n ? Eigen::Vector3d(force_n * (max_force_n / magnitude)) : force_n;
+}
+
+/// Raw speed from which the energy bound acts (passivity.hpp).
+double bounding_speed_m_per_s(double period_s) noexcept {
+  return std::max(kPassivityBoundingMinSpeed_m_per_s,
+                  kPassivityBoundingMinCountsPerTick * kPassivityEncoderCount_m / period_s);
+}
+
 }  // namespace
 
 void observe_energy(PassivityState& state, const Eigen::Vector3d& p_device_m) noexcept {
@@ -48,6 +61,7 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
                                   const Eigen::Vector3d& force_device_n, const Eigen::Vector3d& v_filtered_m_per_s,
                                   const Eigen::Vector3d& v_raw_m_per_s, double period_s) noexcept {
   state.damping_n_s_per_m = 0.0;
+  state.energy_bound_acted = false;
   if (state.recovery_window_left_s > 0.0) {
     state.recovery_window_left_s = std::max(0.0, state.recovery_window_left_s - period_s);
     if (state.recovery_window_left_s <= 0.0) close_recovery_window(state);
@@ -60,11 +74,13 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
     state.added_damping_n_s_per_m = 0.0;
     return force_device_n;
   }
+  // Everything below works on the force the device will render (passivity.hpp).
+  const Eigen::Vector3d force = renderable(force_device_n, config.max_force_n);
   const Eigen::Vector3d& v = v_filtered_m_per_s;
   const double speed = v.norm();
-  const double force_n = force_device_n.norm();
-  const Eigen::Vector3d force_direction =
-      force_n > 0.0 ? Eigen::Vector3d(force_device_n / force_n) : Eigen::Vector3d::Zero();
+  const double force_n = force.norm();
+  const Eigen::Vector3d force_direction = force_n > 0.0 ? Eigen::Vector3d(force / force_n) : Eigen::Vector3d::Zero();
+  const double budget_j = kPassivityRampEnergyBudgetMargins * config.margin_j;
 
   if (speed >= config.min_speed_m_per_s) {
     // Energy by the end of the interval this force acts in: what is observed, plus the
@@ -72,7 +88,7 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
     // the one that predicts more energy out: the filtered one lags by ~3 ms, the raw
     // difference is current but quantised. (Only the decision uses v_raw: it drives ramps,
     // so its noise cannot reach the force as a step.)
-    const Eigen::Vector3d total = state.force_sent_last_device_n + force_device_n;
+    const Eigen::Vector3d total = state.force_sent_last_device_n + force;
     // The damper acts on all of E; the reduction g on E less the forgiven recovery work
     // (kPassivityRecoveryForgiveness_j per fault: a force brought back at a static hold).
     const double predicted_all_j =
@@ -90,7 +106,6 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
     const double returning_m_per_s = force_direction.dot(v_raw_m_per_s);  // F̂·v
     // Power the force returns by the filtered velocity (quantisation-free: ≈ 0 at a hold).
     const double returned_power_w = std::max(0.0, force_direction.dot(v_filtered_m_per_s)) * force_n;
-    const double budget_j = kPassivityRampEnergyBudgetMargins * config.margin_j;
     double target = 0.0;
     if (excess_j > 0.0) {
       if (returning_m_per_s > 0.0 && force_n > 0.0) {
@@ -144,14 +159,36 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
   // give-back at a tenth of the base ramp the Z-width with the controller on fell below the
   // uncontrolled one (a 1–3 mm slow limit cycle at 2–8 kHz, fissure bench rt).
 
+  // Energy bounding at speed (passivity.hpp): the part of F along the motion may return at most
+  // what is left of the budget once E and the command already sent (acting over the next
+  // interval) are counted; the motion is the last raw difference (no filter lag: a teleported
+  // hand reads 1.7 m/s raw while v_f still says 0.2 m/s) or v_f, whichever returns more.
+  // Gated by the raw speed, so it never acts at a hold; it may step the force.
+  if (config.energy_bounding && force_n > 0.0 && v_raw_m_per_s.norm() >= bounding_speed_m_per_s(period_s)) {
+    const double returning_m_per_s =
+        std::max(force_direction.dot(v_raw_m_per_s), force_direction.dot(v_filtered_m_per_s));
+    if (returning_m_per_s > 0.0) {
+      const Eigen::Vector3d& sent = state.force_sent_last_device_n;
+      const double committed_j = state.energy_j - forgiven_j(state, config.margin_j) +
+                                 std::max(sent.dot(v_raw_m_per_s), sent.dot(v_filtered_m_per_s)) * period_s;
+      const double allowed_n = std::max(0.0, budget_j - committed_j) / (returning_m_per_s * period_s);
+      const double bound_fraction = std::clamp(1.0 - allowed_n / force_n, 0.0, 1.0);
+      if (bound_fraction > state.reduction_fraction) {
+        state.reduction_fraction = bound_fraction;
+        state.energy_bound_acted = true;
+        ++state.energy_bound_ticks;
+      }
+    }
+  }
+
   // A fraction of F: the force is reduced, never reversed, and follows F continuously as the
   // contact comes and goes (the fraction persists across bounces).
   state.reduction_n = state.reduction_fraction * force_n;
   const Eigen::Vector3d correction = state.reduction_n * force_direction + state.added_damping_n_s_per_m * v;
-  if (state.reduction_fraction <= 0.0 && state.added_damping_n_s_per_m <= 0.0) return force_device_n;
+  if (state.reduction_fraction <= 0.0 && state.added_damping_n_s_per_m <= 0.0) return force;
   state.damping_n_s_per_m = correction.norm() / std::max(speed, config.min_speed_m_per_s);
   state.dissipated_by_controller_j += correction.dot(v) * period_s;
-  return force_device_n - correction;
+  return force - correction;
 }
 
 void record_sent_force(PassivityState& state, const Eigen::Vector3d& force_device_n) noexcept {

@@ -4,7 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
+#include <utility>
 
+#include "fissure/rt_core/safety.hpp"
 #include "fissure/rt_core/velocity_filter.hpp"
 
 namespace fissure::rt {
@@ -283,6 +287,111 @@ TEST(PassivityController, RestartDropsTheCorrection) {
   EXPECT_DOUBLE_EQ(state.recovery_energy_j, 1e-3);
 }
 
+// The controller works on the force the device renders (clamped to max_force_n), not on an
+// environment force safety will clamp afterwards: against a 27 N contact (rendered at 8 N) its
+// first reduction already lowers what goes out. Before session 4 g acted on the 27 N, and the
+// first 70 % of the reduction left 8 N going out (hc_lambda_over_k_1 stress case).
+TEST(PassivityController, ReducesTheForceTheDeviceRendersNotTheUnclampedOne) {
+  PassivityConfig config;
+  PassivityState state;
+  state.energy_j = 2e-3;  // above the reference: the controller has work to do
+  state.reduction_fraction = 0.2;
+  const Eigen::Vector3d f(0.0, -27.0, 0.0);  // far above the Falcon's 8 N
+  state.force_sent_last_device_n = Eigen::Vector3d(0.0, -8.0, 0.0);
+  const Eigen::Vector3d v(0.0, -0.01, 0.0);  // slowly along the force: below the bound's gate
+  const Eigen::Vector3d out = passivity_control(config, state, f, v, v, kPeriod_s);
+  // g (≥ 0.2) of the 8 N that can go out is taken off: at most 6.4 N (+ the damper) remain.
+  EXPECT_GE(state.reduction_fraction, 0.2);
+  EXPECT_NEAR(state.reduction_n, state.reduction_fraction * config.max_force_n, 1e-12);
+  EXPECT_LE(out.norm(), (1.0 - 0.2) * config.max_force_n + 1e-9);
+  EXPECT_FALSE(state.energy_bound_acted);
+  // Passive with a reserve: nothing to correct, the force goes out as the device renders it.
+  PassivityState passive;
+  passive.energy_j = -1.0;
+  EXPECT_TRUE(passivity_control(config, passive, f, v, v, kPeriod_s).isApprox(Eigen::Vector3d(0.0, -8.0, 0.0)));
+}
+
+// Energy bounding at speed (Kim & Ryu): the force this tick acts over the interval after the
+// next one; what it can return there at the current speed, on top of E and of what the
+// command already sent returns over the next interval, stays within the ramp's energy budget.
+// v_raw says 0.55 m/s (the filtered estimate still 0.08 m/s: its lag is what let the ramps
+// act too late), 8 N push along the motion, 8 N already sent.
+TEST(PassivityController, BoundsTheForceSoThatTheNextIntervalStaysWithinTheBudget) {
+  const PassivityConfig config;
+  const double budget_j = kPassivityRampEnergyBudgetMargins * config.margin_j;
+  const Eigen::Vector3d f(8.0, 0.0, 0.0);
+  const Eigen::Vector3d v_raw(0.55, 0.0, 0.0);
+  const Eigen::Vector3d v_f(0.08, 0.0, 0.0);
+  auto run = [&](double energy_j) {
+    PassivityState state;
+    state.energy_j = energy_j;
+    state.force_sent_last_device_n = f;
+    const Eigen::Vector3d out = passivity_control(config, state, f, v_f, v_raw, kPeriod_s);
+    return std::pair{state, out};
+  };
+  // E = −3 mJ: the sent 8 N returns 4.4 mJ over the next interval, 2.6 mJ of the budget are
+  // left, so this tick's force may push the hand out with 2.6 mJ / (0.55 m/s · 1 ms) = 4.73 N.
+  {
+    const auto [state, out] = run(-3e-3);
+    const double allowed_n = (budget_j - (-3e-3 + 8.0 * 0.55 * kPeriod_s)) / (0.55 * kPeriod_s);
+    EXPECT_TRUE(state.energy_bound_acted);
+    EXPECT_NEAR(state.reduction_fraction, 1.0 - allowed_n / 8.0, 1e-12);
+    EXPECT_NEAR(out.x() + state.added_damping_n_s_per_m * v_f.x(), allowed_n, 1e-9);
+    EXPECT_LE(-3e-3 + (8.0 + out.x()) * 0.55 * kPeriod_s, budget_j + 1e-12);  // the bound holds
+  }
+  // E = +1 mJ: the command already sent uses up the budget; nothing may push out any more —
+  // a step from 8 N to ≤ 0 (safety's rate limit then takes it down at 4 N per tick).
+  {
+    const auto [state, out] = run(1e-3);
+    EXPECT_TRUE(state.energy_bound_acted);
+    EXPECT_EQ(state.reduction_fraction, 1.0);
+    EXPECT_LE(out.x(), 0.0);
+  }
+  // E = −10 mJ: enough reserve for the full 8 N over both intervals: the bound does nothing.
+  {
+    const auto [state, out] = run(-10e-3);
+    EXPECT_FALSE(state.energy_bound_acted);
+    EXPECT_EQ(state.reduction_fraction, 0.0);
+    EXPECT_EQ(out, f);
+  }
+  // Moving into the force (the hand presses in): nothing is returned, nothing to bound.
+  {
+    PassivityState state;
+    state.energy_j = 1e-3;
+    state.force_sent_last_device_n = f;
+    passivity_control(config, state, f, -v_f, -v_raw, kPeriod_s);
+    EXPECT_FALSE(state.energy_bound_acted);
+  }
+}
+
+// The bound is gated by the raw speed, so it never steps the force at a hold: there the raw
+// difference toggles by one encoder count per tick (50 mm/s at 1 kHz, 0.2 m/s at 250 Hz) and
+// only the ramps act, even with E at the budget.
+TEST(PassivityController, TheEnergyBoundNeverActsAtAHold) {
+  const PassivityConfig config;
+  for (const double rate_hz : {250.0, 500.0, 1000.0, 4000.0}) {
+    const double period_s = 1.0 / rate_hz;
+    PassivityState state;
+    state.energy_j = kPassivityRampEnergyBudgetMargins * config.margin_j;  // at the budget
+    const Eigen::Vector3d f(0.0, 0.0, 8.0);
+    state.force_sent_last_device_n = f;
+    const Eigen::Vector3d one_count(0.0, 0.0, kCount_m / period_s);  // quantisation toggle, outwards
+    const Eigen::Vector3d tremor(0.0, 0.0, 0.005);
+    const double before_n = state.reduction_n;
+    passivity_control(config, state, f, tremor, one_count, period_s);
+    EXPECT_FALSE(state.energy_bound_acted) << rate_hz << " Hz";
+    EXPECT_LE(state.reduction_n - before_n, config.max_correction_step_n * kPassivityMaxUrgency + 1e-12) << rate_hz;
+    // Four counts per tick at 1 kHz (0.2 m/s) is not a hold: there it acts.
+    if (rate_hz == 1000.0) {
+      PassivityState fast = PassivityState{};
+      fast.energy_j = state.energy_j;
+      fast.force_sent_last_device_n = f;
+      passivity_control(config, fast, f, tremor, Eigen::Vector3d(0.0, 0.0, kPassivityBoundingMinSpeed_m_per_s), period_s);
+      EXPECT_TRUE(fast.energy_bound_acted);
+    }
+  }
+}
+
 // ----------------------------------------------------------------------------------------
 // Closed loops in one dimension (x along the wall normal): the tick's order — observe the
 // quantised sample, filter the velocity, compute the wall force, passivity control, record —
@@ -296,11 +405,13 @@ struct Plant {
   double hand_damping_n_s_per_m = 5.0;
   double x_m = 0.0, v_m_per_s = 0.0;
   /// Semi-implicit Euler at 20 kHz over one tick, motor force held (zero-order hold).
-  void advance(double motor_force_n, double hand_target_m, double period_s) {
+  /// The hand is a spring-damper to a target moving at hand_target_m_per_s.
+  void advance(double motor_force_n, double hand_target_m, double period_s, double hand_target_m_per_s = 0.0) {
     constexpr int kSubsteps = 20;
     const double dt = period_s / kSubsteps;
     for (int i = 0; i < kSubsteps; ++i) {
-      const double hand = hand_stiffness_n_per_m * (hand_target_m - x_m) - hand_damping_n_s_per_m * v_m_per_s;
+      const double hand = hand_stiffness_n_per_m * (hand_target_m - x_m) +
+                          hand_damping_n_s_per_m * (hand_target_m_per_s - v_m_per_s);
       v_m_per_s += dt * (motor_force_n + hand - damping_n_s_per_m * v_m_per_s) / mass_kg;
       x_m += dt * v_m_per_s;
     }
@@ -424,6 +535,122 @@ TEST(PassivityClosedLoop, AnActiveWallEndsWithBoundedObservedEnergy) {
   EXPECT_LE(with.energy_end_j - with.energy_at_two_thirds_j,
             0.1 * (without.energy_end_j - without.energy_at_two_thirds_j));
   EXPECT_LT(with.energy_end_j, 0.25 * without.energy_end_j);
+}
+
+// ----------------------------------------------------------------------------------------
+// The stress harness's hc_lambda_over_k_1 / hand_teleports failures, in one dimension: a hand
+// presses 5 mm into a stiff, heavily damped Hunt-Crossley contact (5000 N/m, λ = 1 s/m: ~30 N,
+// rendered at the Falcon's 8 N), the body then follows the tool out slowly (a host proxy that
+// moves: the contact returns what it stored, so E climbs back to the reference at 8 N), and
+// the hand flicks out at 5–10 m/s through its 300 N/m grip. The device leaves the contact at
+// 1–2 m/s while the full 8 N pushes it out; both commands on their way through the ping-pong
+// return that before any correction acts, and the ramps (≤ 2 N per tick) act from the tick
+// after. Safety (8 N clamp, 4 N per tick rate limit) sits between the controller and the plant.
+struct FlickResult {
+  double energy_max_j = 0.0;
+  std::uint64_t bound_ticks_before_flick = 0;  ///< the energy bound must not act before the flick
+  double max_step_before_flick_n = 0.0;        ///< largest per-tick change of the sent force
+};
+
+FlickResult run_flick(const PassivityConfig& config, double follow_m, double flick_m_per_s) {
+  constexpr double kStiffness_n_per_m = 5000.0, kLambda_s_per_m = 1.0;
+  constexpr double kDepth_m = 0.005, kPressSpeed_m_per_s = 0.05, kFollowSpeed_m_per_s = 0.02;
+  Plant plant;
+  plant.x_m = 0.002;
+  const double x_press = -kDepth_m - kFalconMaxForce_n / plant.hand_stiffness_n_per_m;  // holds 5 mm in at 8 N
+  const double t_in = (plant.x_m - x_press) / kPressSpeed_m_per_s, t_hold = t_in + 0.2;
+  const double t_flick = t_hold + follow_m / kFollowSpeed_m_per_s;
+  const double x_out = 0.03, t_end = t_flick + (x_out - x_press - follow_m) / flick_m_per_s + 0.2;
+  auto hand = [&](double t) {  // target position and velocity
+    if (t < t_in) return std::pair{0.002 - kPressSpeed_m_per_s * t, -kPressSpeed_m_per_s};
+    if (t < t_hold) return std::pair{x_press, 0.0};
+    if (t < t_flick) return std::pair{x_press + kFollowSpeed_m_per_s * (t - t_hold), kFollowSpeed_m_per_s};
+    const double x = x_press + follow_m + flick_m_per_s * (t - t_flick);
+    return x < x_out ? std::pair{x, flick_m_per_s} : std::pair{x_out, 0.0};
+  };
+  auto surface = [&](double t) { return t < t_hold ? 0.0 : std::min(follow_m, kFollowSpeed_m_per_s * (t - t_hold)); };
+
+  const VelocityFilterCoefficients filter = design_velocity_filter(100.0, kRate_hz);
+  VelocityFilterState velocity;
+  PassivityState state;
+  SafetyConfig safety_config;
+  SafetyState safety;
+  start_ramp_in(safety, 0.0);  // ramped in already
+  FlickResult result;
+  double acting_n = 0.0, last_sent_n = 0.0;
+  for (int k = 0; k * kPeriod_s < t_end; ++k) {
+    const double t_s = k * kPeriod_s;
+    const Eigen::Vector3d p(quantise(plant.x_m), 0.0, 0.0);
+    const Eigen::Vector3d raw = velocity.primed ? Eigen::Vector3d((p - velocity.p_prev_device_m) / kPeriod_s)
+                                                : Eigen::Vector3d::Zero();
+    observe_energy(state, p);
+    const Eigen::Vector3d v = update_velocity(filter, velocity, p, kPeriod_s);
+    const double depth_m = std::max(0.0, surface(t_s) - p.x());
+    const double wall_n = std::max(0.0, kStiffness_n_per_m * depth_m * (1.0 - kLambda_s_per_m * v.x()));
+    const Eigen::Vector3d out = passivity_control(config, state, Eigen::Vector3d(wall_n, 0.0, 0.0), v, raw, kPeriod_s);
+    SafetyInput input;
+    input.force_device_n = out;
+    std::uint32_t flags = 0;
+    const double sent_n = apply_safety(safety_config, safety, input, kPeriod_s, flags).x();
+    record_sent_force(state, Eigen::Vector3d(sent_n, 0.0, 0.0));
+    if (t_s < t_flick) {
+      result.bound_ticks_before_flick = state.energy_bound_ticks;
+      if (k > 0) result.max_step_before_flick_n = std::max(result.max_step_before_flick_n, std::abs(sent_n - last_sent_n));
+    }
+    last_sent_n = sent_n;
+    const auto [target_m, target_m_per_s] = hand(t_s);
+    plant.advance(acting_n, target_m, kPeriod_s, target_m_per_s);
+    acting_n = sent_n;
+    result.energy_max_j = std::max(result.energy_max_j, state.energy_j);
+  }
+  return result;
+}
+
+// The stress harness's bound (app/stress_cases.hpp, kStressEnergyBound_j).
+constexpr double kStressEnergyBound_j = 0.025;
+
+/// Worst energy over the flicks: 5 and 10 m/s, the body following 2–6 mm (E at the flick from
+/// −19 mJ to +5 mJ).
+double worst_flick_energy_j(const PassivityConfig& config, FlickResult* worst_before_flick = nullptr) {
+  double worst_j = 0.0;
+  for (const double flick_m_per_s : {5.0, 10.0}) {
+    for (int i = 0; i <= 8; ++i) {
+      const FlickResult r = run_flick(config, 0.002 + 0.0005 * i, flick_m_per_s);
+      worst_j = std::max(worst_j, r.energy_max_j);
+      if (worst_before_flick != nullptr) {
+        worst_before_flick->bound_ticks_before_flick =
+            std::max(worst_before_flick->bound_ticks_before_flick, r.bound_ticks_before_flick);
+        worst_before_flick->max_step_before_flick_n =
+            std::max(worst_before_flick->max_step_before_flick_n, r.max_step_before_flick_n);
+      }
+    }
+  }
+  return worst_j;
+}
+
+TEST(PassivityClosedLoop, AFlickOutOfAStiffDampedContactStaysWithinTheEnergyBound) {
+  FlickResult before_flick;
+  const double worst_j = worst_flick_energy_j(PassivityConfig{}, &before_flick);
+  EXPECT_LE(worst_j, 0.8 * kStressEnergyBound_j);  // 16.1 mJ measured
+  // Until the flick (press, hold, slow follow) the hand is never fast: no step from the bound,
+  // and no force step beyond the wall's own (K·count = 0.25 N per count of motion). (The
+  // controller before session 4 stepped 4 N there: its reduction of the unclamped 30 N only
+  // reached the hand once it exceeded 22 N, then all at once.)
+  EXPECT_EQ(before_flick.bound_ticks_before_flick, 0u);
+  EXPECT_LE(before_flick.max_step_before_flick_n, 0.35);
+}
+
+// What the test above holds down is real: the controller before session 4 (reduction of the
+// unclamped force, no energy bound) let the same flicks reach 30.5 mJ, and acting on the
+// rendered force alone is not enough (29.2 mJ): the ramps act a tick too late.
+TEST(PassivityClosedLoop, TheFlickExceedsTheEnergyBoundWithoutEnergyBounding) {
+  PassivityConfig before_session_4;
+  before_session_4.energy_bounding = false;
+  before_session_4.max_force_n = std::numeric_limits<double>::infinity();
+  EXPECT_GT(worst_flick_energy_j(before_session_4), kStressEnergyBound_j);
+  PassivityConfig clamp_only;
+  clamp_only.energy_bounding = false;
+  EXPECT_GT(worst_flick_energy_j(clamp_only), kStressEnergyBound_j);
 }
 
 }  // namespace

@@ -45,21 +45,48 @@
 // The cost is that E may overshoot 0 briefly; what the observer sees is still returned.
 // Below min_speed_m_per_s r and β hold their values: the direction of v_f is noise there, and
 // a force at standstill does no work.
+//
+// The force the controller works on is the one the device can render: the environment force
+// clamped to max_force_n (safety's clamp, which comes after). Until session 4 g acted on the
+// unclamped force, so against a 27 N contact rendered at 8 N the first 70 % of the reduction
+// changed nothing the hand felt (hc_lambda_over_k_1 stress case, t = 66.7 s: g = 0.39 on
+// 11.8 N still sent 7.1 N) and the prediction E' counted a force that never went out.
+//
+// Energy bounding at speed (Kim & Ryu 2004, session 4). The ramps above act from the next tick
+// on, at most 2 N per tick; a hand that leaves a contact at 1–2 m/s while the full 8 N pushes it
+// out receives 8–16 mJ per tick, and the two commands already on their way (the ping-pong)
+// return that twice before any correction acts (hc_lambda_over_k_1: E from −2.8 to +32.5 mJ in
+// 5 ticks; hand_teleports: 1.3 → 26.0 mJ in 3 ticks). So once the device moves at least
+// kPassivityBoundingMinSpeed_m_per_s (raw difference: never a hold), the force is bounded
+// outright so that what the interval it acts in can return at the current speed stays within
+// what is left of the ramp's energy budget after the command already sent:
+//     E_less_forgiven + F_sent·v·T + (1 − g)·|F|·(F̂·v)·T ≤ kPassivityRampEnergyBudgetMargins·margin
+// (v: whichever of v_raw, v_f returns more). This may step the force — by design, and only at a
+// speed no hand holding still reaches; safety's rate limit (4 N per tick) still applies.
+// What it cannot bound is the work of the command already sent (and of the one whose motion
+// was just observed): at 1.7 m/s and 6 N that is ≈ 10 mJ per tick (hand_teleports).
+#include <cstdint>
+
 #include <Eigen/Core>
+
+#include "fissure/rt_core/safety.hpp"
 
 namespace fissure::rt {
 
+/// One encoder count of end-effector motion near the workspace centre [m] (BRIEF §6: ≈ 0.05 mm):
+/// the resolution of every position the observer pairs with a force.
+inline constexpr double kPassivityEncoderCount_m = 50e-6;
 /// Reference energy margin [J]: the observer's own resolution at the Falcon's rated force —
-/// one encoder count (≈ 50 µm at the workspace centre, BRIEF §6) of motion under 8 N is
-/// 0.4 mJ, so an E within that of zero is indistinguishable from zero.
-inline constexpr double kDefaultPassivityMargin_j = 8.0 * 50e-6;
+/// one encoder count of motion under 8 N is 0.4 mJ, so an E within that of zero is
+/// indistinguishable from zero.
+inline constexpr double kDefaultPassivityMargin_j = kFalconMaxForce_n * kPassivityEncoderCount_m;
 /// Largest change of the force reduction per tick while E' ≤ 0 [N]: the bound issue 6 sets
 /// for a proxy swap (max |ΔF| per tick ≤ 0.05 N) — the same "no felt click" criterion applies
 /// to the controller's own force changes.
 inline constexpr double kDefaultPassivityCorrectionStep_n = 0.05;
-/// Cap of the urgency factor 1 + E'/margin that steepens the reduction's ramp once energy
-/// has really been created: at most 4 × 0.05 = 0.2 N per tick. Uncapped, a large E' turned the
-/// ramp back into the one-tick switch this controller replaces.
+/// Cap of the urgency factor 1 + E'/(10·margin) that steepens the reduction's ramp once energy
+/// has really been created: at most 40 × 0.05 = 2 N per tick (reached at E' = 0.16 J).
+/// Uncapped, a large E' turned the ramp back into the one-tick switch this controller replaces.
 inline constexpr double kPassivityMaxUrgency = 40.0;
 /// Energy scale of the urgency factor, in margins: 1 + E'/(10·margin), i.e. twice as steep
 /// at E' = 4 mJ, 7× at the stress harness's 25 mJ bound.
@@ -70,6 +97,15 @@ inline constexpr double kPassivityUrgencyMargins = 10.0;
 /// which the urgency factor doubles: small against the stress harness's 25 mJ bound, large
 /// against what a hold returns between two ticks (≲ 10 µJ), so holds keep the 0.05 N ramp.
 inline constexpr double kPassivityRampEnergyBudgetMargins = 10.0;
+/// Raw speed from which the energy bound acts [m/s]: 0.2 m/s is 4 encoder counts per 1 kHz
+/// tick. A hand holding still moves ≲ 1 cm/s and its raw difference toggles by one count per
+/// tick (50 mm/s at 1 kHz, 100 mm/s at 500 Hz), so the bound never acts at a hold, where a step
+/// would be felt as a click; at 0.2 m/s the full 8 N returns 1.6 mJ per tick, 40 % of the ramp's
+/// energy budget, so below it the ramps keep up.
+inline constexpr double kPassivityBoundingMinSpeed_m_per_s = 0.2;
+/// …and at least this many encoder counts per tick, so that at a low tick rate (250 Hz: one
+/// count per tick reads 0.2 m/s) the quantisation toggle of a hold still stays below the gate.
+inline constexpr double kPassivityBoundingMinCountsPerTick = 2.0;
 /// Time over which the controller aims to dissipate the excess energy [s] (reference-energy
 /// following): 50 ms, a few periods of the hand–device resonance (≈ 7 Hz with a 300 N/m grip)
 /// and of a stiff contact (≈ 20–70 Hz), so the correction stays a small, smooth force.
@@ -114,6 +150,12 @@ struct PassivityConfig {
   double dissipation_time_s = kDefaultPassivityDissipationTime_s;
   /// 0 → max_damping_n_s_per_m ramp time of the added damper [s].
   double damping_ramp_s = kDefaultPassivityDampingRamp_s;
+  /// Largest force the device renders [N]: the environment force is clamped to it (direction
+  /// kept) before the controller acts, so g and E' work on the force that goes out. Must equal
+  /// SafetyConfig::max_force_n (the clamp after the controller); both default to the Falcon's 8 N.
+  double max_force_n = kFalconMaxForce_n;
+  /// Energy bounding at speed (see above); off only to measure what it does.
+  bool energy_bounding = true;
 };
 
 struct PassivityState {
@@ -131,8 +173,11 @@ struct PassivityState {
   double reduction_n = 0.0;               ///< r = g·|F| in the last tick [N]
   double added_damping_n_s_per_m = 0.0;   ///< β
   /// Telemetry: the correction expressed as a damping, |F − F_out| / max(|v_f|, min_speed)
-  /// [N·s/m]; > 0 exactly when the controller changed the force this tick.
+  /// [N·s/m] (F clamped to max_force_n); > 0 exactly when the controller changed the force.
   double damping_n_s_per_m = 0.0;
+  /// Telemetry: the energy bound raised g this tick (it stepped the force).
+  bool energy_bound_acted = false;
+  std::uint64_t energy_bound_ticks = 0;  ///< ticks in which the energy bound raised g
 };
 
 /// Observer: account the work done since the previous sample. Call once per good sample.
