@@ -49,8 +49,9 @@
 // The force the controller works on is the one the device can render: the environment force
 // clamped to max_force_n (safety's clamp, which comes after). Until session 4 g acted on the
 // unclamped force, so against a 27 N contact rendered at 8 N the first 70 % of the reduction
-// changed nothing the hand felt (hc_lambda_over_k_1 stress case, t = 66.7 s: g = 0.39 on
-// 11.8 N still sent 7.1 N) and the prediction E' counted a force that never went out.
+// changed nothing the hand felt (hc_lambda_over_k_1 stress case, t = 66.7 s: r = 1.1 N off
+// 12.3 N still sent 8 N; the next tick r = 4.6 N off 11.8 N took only 0.9 N off what went out)
+// and the prediction E' counted a force that never went out.
 //
 // Energy bounding at speed (Kim & Ryu 2004, session 4). The ramps above act from the next tick
 // on, at most 2 N per tick; a hand that leaves a contact at 1–2 m/s while the full 8 N pushes it
