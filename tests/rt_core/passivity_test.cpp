@@ -365,7 +365,7 @@ TEST(PassivityController, BoundsTheForceSoThatTheNextIntervalStaysWithinTheBudge
 }
 
 // The bound is gated by the raw speed, so it never steps the force at a hold: there the raw
-// difference toggles by one encoder count per tick (50 mm/s at 1 kHz, 0.2 m/s at 250 Hz) and
+// difference toggles by one encoder count per tick (50 mm/s at 1 kHz, 0.2 m/s at 4 kHz) and
 // only the ramps act, even with E at the budget.
 TEST(PassivityController, TheEnergyBoundNeverActsAtAHold) {
   const PassivityConfig config;

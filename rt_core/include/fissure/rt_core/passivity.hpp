@@ -100,11 +100,11 @@ inline constexpr double kPassivityUrgencyMargins = 10.0;
 inline constexpr double kPassivityRampEnergyBudgetMargins = 10.0;
 /// Raw speed from which the energy bound acts [m/s]: 0.2 m/s is 4 encoder counts per 1 kHz
 /// tick. A hand holding still moves ≲ 1 cm/s and its raw difference toggles by one count per
-/// tick (50 mm/s at 1 kHz, 100 mm/s at 500 Hz), so the bound never acts at a hold, where a step
-/// would be felt as a click; at 0.2 m/s the full 8 N returns 1.6 mJ per tick, 40 % of the ramp's
-/// energy budget, so below it the ramps keep up.
+/// tick (count × rate: 25 mm/s at 500 Hz, 50 mm/s at 1 kHz), so the bound never acts at a hold,
+/// where a step would be felt as a click; at 0.2 m/s the full 8 N returns 1.6 mJ per 1 ms tick,
+/// 40 % of the ramp's energy budget, so below it the ramps keep up.
 inline constexpr double kPassivityBoundingMinSpeed_m_per_s = 0.2;
-/// …and at least this many encoder counts per tick, so that at a low tick rate (250 Hz: one
+/// …and at least this many encoder counts per tick, so that at a high tick rate (4 kHz: one
 /// count per tick reads 0.2 m/s) the quantisation toggle of a hold still stays below the gate.
 inline constexpr double kPassivityBoundingMinCountsPerTick = 2.0;
 /// Time over which the controller aims to dissipate the excess energy [s] (reference-energy
