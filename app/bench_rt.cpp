@@ -21,7 +21,9 @@
 //    K < 2b/T. Stable: peak-to-peak position over the last 0.3 s of the hold ≤ 0.25 mm (5
 //    encoder counts). Passive: Σ F_motor·Δp − Σ b·|v|²·T ≤ 0 over the run, the damper counted
 //    only while the wall pushes (virtual wall plus the device's physical damper, the port
-//    Colgate & Schenkel's bound is about), from SimFalcon's ground truth.
+//    Colgate & Schenkel's bound is about), from SimFalcon's ground truth. Renders: the wall's
+//    mean force over the hold window is ≥ half its equilibrium force against the hand spring
+//    (a wall held back to nothing is passive and still, and not a wall).
 #include "bench_rt.hpp"
 #include "machine_info.hpp"
 
@@ -77,6 +79,12 @@ constexpr double kZwidthFirstK_n_per_m = 250.0;
 constexpr double kZwidthGridRatio = 1.25;
 constexpr double kZwidthMaxK_n_per_m = 400'000.0;
 constexpr double kStablePeakToPeak_m = 0.25e-3;
+/// A wall "renders" when its mean force over the hold window is at least this share of the
+/// equilibrium force it should hold the hand with. Without it a passivity controller that holds
+/// the wall back to 0 N counted as stable and passive (session 5: 0 N held at every K ≥ 1192 N/m
+/// at 1 kHz, reported as a Z-width of 394 kN/m). Half: a rendered wall sits within a few % of the
+/// equilibrium; the controller's transient reductions decay within its 50 ms dissipation time.
+constexpr double kMinHeldForceShare = 0.5;
 
 double quantile_sorted(const std::vector<double>& sorted, double q) {
   if (sorted.empty()) return 0.0;
@@ -404,8 +412,11 @@ nlohmann::json cyclictest_json(const CyclictestResult& c) {
 struct WallRun {
   bool stable = false;
   bool passive = false;
+  bool renders = false;          ///< the wall holds the hand back with at least kMinHeldForceShare of its force
   double peak_to_peak_m = 0.0;
-  double port_energy_j = 0.0;  ///< Σ F_motor·Δp − Σ b|v|²T
+  double port_energy_j = 0.0;    ///< Σ F_motor·Δp − Σ b|v|²T
+  double held_force_n = 0.0;     ///< mean motor force along the wall normal over the hold window
+  double expected_force_n = 0.0; ///< the wall's force at the hand–wall equilibrium
 };
 
 WallRun run_wall(double rate_hz, double stiffness, bool passivity_on) {
@@ -432,12 +443,20 @@ WallRun run_wall(double rate_hz, double stiffness, bool passivity_on) {
   auto telemetry = std::make_unique<rt::TelemetryRing>();
   auto loop = std::make_unique<rt::RtLoop>(model, sim, clock, proxy_in, state_out, *telemetry);
 
+  // The hand spring pulls towards 12 mm inside the centre, the wall surface is 4 mm inside: at
+  // equilibrium K·x = k_grip·(8 mm − x), so the wall should hold F = K·k_grip·8 mm / (K + k_grip)
+  // (→ 2.4 N for a stiff wall), capped by safety's force limit.
+  const double hand_past_wall_m = 0.012 - 0.004;
+  const double k_grip = hand.grip_stiffness_n_per_m;
   const double hold_start_s = 0.6 + 0.012 / 0.1;
   const double window_start_s = hold_start_s + 0.8 - 0.3;
   const double window_end_s = hold_start_s + 0.8;
   const auto ticks = static_cast<int>((window_end_s + 0.12 + 0.2) * rate_hz);
   const auto publish_every = std::max(1, static_cast<int>(rate_hz / 1000.0));  // a 1 kHz host
   WallRun run;
+  run.expected_force_n = std::min(config.safety.max_force_n, stiffness * k_grip * hand_past_wall_m / (stiffness + k_grip));
+  double held_force_sum_n = 0.0;
+  long held_samples = 0;
   double y_min = 1e9, y_max = -1e9;
   double motor_work_j = 0.0, damper_work_j = 0.0;
   Eigen::Vector3d p_prev = sim.truth().position_device_m;
@@ -468,21 +487,25 @@ WallRun run_wall(double rate_hz, double stiffness, bool passivity_on) {
     if (t >= window_start_s && t <= window_end_s) {
       y_min = std::min(y_min, truth.position_device_m.y());
       y_max = std::max(y_max, truth.position_device_m.y());
+      held_force_sum_n += truth.motor_force_device_n.y();
+      ++held_samples;
     }
   }
   run.peak_to_peak_m = y_max - y_min;
   run.port_energy_j = motor_work_j - damper_work_j;
   run.stable = run.peak_to_peak_m <= kStablePeakToPeak_m;
   run.passive = run.port_energy_j <= 0.0;
+  run.held_force_n = held_samples > 0 ? held_force_sum_n / static_cast<double>(held_samples) : 0.0;
+  run.renders = run.held_force_n >= kMinHeldForceShare * run.expected_force_n;
   return run;
 }
 
-/// Largest K on the grid before the first unstable or active one.
+/// Largest K on the grid before the first unstable, active or held-back one.
 double zwidth_k(double rate_hz, bool passivity_on, WallRun& first_failure) {
   double last_good = 0.0;
   for (double k = kZwidthFirstK_n_per_m; k <= kZwidthMaxK_n_per_m; k *= kZwidthGridRatio) {
     const WallRun run = run_wall(rate_hz, k, passivity_on);
-    if (!run.stable || !run.passive) {
+    if (!run.stable || !run.passive || !run.renders) {
       first_failure = run;
       return last_good;
     }
@@ -646,16 +669,22 @@ void run(const Arguments& args) {
                       {"ratio_off_to_bound", k_off / bound},
                       {"first_failure_off", {{"peak_to_peak_m", failure_off.peak_to_peak_m},
                                              {"port_energy_j", failure_off.port_energy_j},
-                                             {"stable", failure_off.stable}, {"passive", failure_off.passive}}},
+                                             {"stable", failure_off.stable}, {"passive", failure_off.passive},
+                                             {"renders", failure_off.renders}, {"held_force_n", failure_off.held_force_n},
+                                             {"expected_force_n", failure_off.expected_force_n}}},
                       {"first_failure_on", {{"peak_to_peak_m", failure_on.peak_to_peak_m},
                                             {"port_energy_j", failure_on.port_energy_j},
-                                            {"stable", failure_on.stable}, {"passive", failure_on.passive}}}});
+                                            {"stable", failure_on.stable}, {"passive", failure_on.passive},
+                                             {"renders", failure_on.renders}, {"held_force_n", failure_on.held_force_n},
+                                             {"expected_force_n", failure_on.expected_force_n}}}});
   }
   out["zwidth"] = zwidth;
   out["zwidth_method"] =
       "undamped wall (n=1, lambda=0) pressed 8 mm deep by a hand spring (300 N/m, no damping), held 0.8 s, released; "
       "grid K = 250·1.25^i N/m; stable: peak-to-peak over the last 0.3 s of the hold <= 0.25 mm; passive: "
-      "sum F_motor·dp - sum b|v|^2 T (the damper counted only while the motor force is non-zero) <= 0 (SimFalcon ground truth); proxy refreshed at min(rate, 1 kHz)";
+      "sum F_motor·dp - sum b|v|^2 T (the damper counted only while the motor force is non-zero) <= 0 (SimFalcon ground truth); "
+      "renders: mean motor force along the normal over the hold window >= 50 % of the equilibrium wall force K·k·8mm/(K+k) "
+      "(a wall the passivity controller holds back to nothing is not a rendered wall); proxy refreshed at min(rate, 1 kHz)";
 
   std::ofstream file(args.json_path);
   if (!file) throw CommandError("cannot write --json file '" + args.json_path + "'");

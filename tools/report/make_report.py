@@ -618,9 +618,28 @@ def section_rt(report, data, problems, targets):
         report.figure(fig, "zwidth_vs_rate.png", "Z-width against tick rate")
         report.add(rt.get("zwidth_method", ""))
         report.add("")
-        report.add(table(["rate Hz", "bound 2b/T N/m", "K max PC off N/m", "K max PC on N/m", "off / bound"],
+        def first_failure(f):
+            # Which criterion ended the grid: the next K was unstable, active, or held back.
+            if not f:
+                return "—"
+            why = [w for w, ok in (("unstable", f.get("stable", True)), ("active", f.get("passive", True))) if not ok]
+            if not f.get("renders", True):
+                why.append(f"held back: {fmt(f.get('held_force_n'))} of {fmt(f.get('expected_force_n'))} N")
+            return ", ".join(why) or "—"
+        report.add(table(["rate Hz", "bound 2b/T N/m", "K max PC off N/m", "next K, PC off", "K max PC on N/m", "next K, PC on", "off / bound"],
                          [[fmt(r["rate_hz"]), fmt(r["colgate_bound_k_n_per_m"]), fmt(r["k_max_passivity_off_n_per_m"]),
-                           fmt(r["k_max_passivity_on_n_per_m"]), fmt(r["ratio_off_to_bound"])] for r in z]))
+                           first_failure(r.get("first_failure_off")), fmt(r["k_max_passivity_on_n_per_m"]),
+                           first_failure(r.get("first_failure_on")), fmt(r["ratio_off_to_bound"])] for r in z]))
+        held_back = [r for r in z if not (r.get("first_failure_on") or {}).get("renders", True)]
+        if held_back:
+            report.add("")
+            report.add(f"With the passivity controller on, {len(held_back)} of {len(z)} rates end on a wall *held back*: "
+                       "the observer's energy is above its reference after the impact, the controller's reduction is "
+                       "full, and a hand at rest does no work that would let it relax, so a wall the hand has sunk into "
+                       "stays near 0 N. Without the 'renders' criterion (session 5) that counted as stable and passive "
+                       "(the session-4 report read 5.7–21.7 kN/m here). Not fixed; a drift-compensating controller is "
+                       "the known remedy.")
+            report.add("")
         report.add(targets_table([t for t in targets if t.section == "zwidth"]))
 
 
