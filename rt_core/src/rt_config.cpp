@@ -43,6 +43,11 @@ const char* check_config(const RtConfig& c) noexcept {
   if (!(positive(c.safety.max_force_n) && c.safety.max_force_n <= kFalconMaxForce_n)) {
     return "safety.max_force_n must be in (0, 8] N (the Falcon's rating)";
   }
+  // The controller bounds the energy of the force the device will render, i.e. after safety's
+  // clamp; a different clamp here would let it predict a force that is never sent (or miss one).
+  if (c.passivity.max_force_n != c.safety.max_force_n) {
+    return "passivity.max_force_n must equal safety.max_force_n (the controller acts on the force safety lets through)";
+  }
   if (!positive(c.safety.max_force_rate_n_per_s)) return "safety.max_force_rate_n_per_s must be > 0";
   if (!c.safety.workspace_centre_device_m.allFinite() || !positive(c.safety.workspace_radius_m)) {
     return "safety.workspace_centre_device_m must be finite and workspace_radius_m > 0";

@@ -42,6 +42,11 @@ TEST(RtConfig, BadFieldsAreNamed) {
   config.safety.max_force_n = 9.0;  // above the Falcon's rating
   EXPECT_NE(error_of(config).find("safety.max_force_n"), std::string::npos);
   config = RtConfig{};
+  config.safety.max_force_n = 5.0;  // a lower clamp the passivity controller was not told about
+  EXPECT_NE(error_of(config).find("passivity.max_force_n"), std::string::npos);
+  config.passivity.max_force_n = 5.0;
+  EXPECT_EQ(error_of(config), "");
+  config = RtConfig{};
   config.velocity.cutoff_hz = 600.0;  // above Nyquist at 1 kHz
   EXPECT_NE(error_of(config).find("velocity.cutoff_hz"), std::string::npos);
   config = RtConfig{};
