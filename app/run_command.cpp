@@ -78,6 +78,9 @@ void run(const RunOptions& options) {
               s["crossed_nodes_max"].get<int>(), s["faults"].get<unsigned long long>(),
               s["overruns"].get<unsigned long long>(), s["force_max_n"].get<double>(), s["force_limit_n"].get<double>(),
               s["energy_j"].get<double>());
+  std::printf("  tool re-seats %llu (device position discontinuities) | soft volume min %.2f of settled%s\n",
+              s["tool_reseats"].get<unsigned long long>(), s["soft_volume_ratio_min"].get<double>(),
+              s["soft_everted"].get<bool>() ? " — SOFT BODY TURNED INSIDE OUT" : "");
   std::printf("  proxy age median %.2f ms, p99 %.2f ms | host step median %.3f ms, p99 %.3f ms%s\n",
               s["proxy_age_ms"]["median"].get<double>(), s["proxy_age_ms"]["p99"].get<double>(),
               s["host_step_ms"]["median"].get<double>(), s["host_step_ms"]["p99"].get<double>(),

@@ -46,6 +46,8 @@ void SessionRecorder::add_host_step(const HostStatus& host) {
   last_host_ = host;
   ++figures_.host_steps;
   figures_.crossed_nodes_max = std::max(figures_.crossed_nodes_max, host.crossed_nodes);
+  figures_.tool_reseats = host.tool_reseats;
+  figures_.soft_volume_ratio_min = std::min(figures_.soft_volume_ratio_min, host.soft_volume_ratio);
   figures_.host_penetration_max_m = std::max(figures_.host_penetration_max_m, host.max_penetration_m);
   figures_.host_force_max_n = std::max(figures_.host_force_max_n, host.force_n);
   figures_.host_step_ms.push_back(host.step_cpu_s * 1e3);

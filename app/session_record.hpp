@@ -30,6 +30,8 @@ struct SessionFigures {
   double energy_j = 0.0;                   ///< passivity observer at the last sample (> 0: active)
   double energy_max_j = 0.0;               ///< its maximum over the session
   int crossed_nodes_max = 0;
+  std::uint64_t tool_reseats = 0;          ///< host re-seated its tool (device position epoch changed)
+  double soft_volume_ratio_min = 1.0;      ///< lowest signed soft volume / settled (< 0: turned inside out)
   double host_penetration_max_m = 0.0;     ///< deepest soft node inside the tool (host)
   double host_force_max_n = 0.0;
   std::uint64_t host_steps = 0;

@@ -388,6 +388,9 @@ SessionOutcome run_session(const SessionOptions& options) {
   const double ticking_s = to_seconds(f.last_tick_time_ns - f.first_tick_time_ns);
   summary["tick_rate_hz"] = ticking_s > 0.0 ? static_cast<double>(f.telemetry_samples - 1) / ticking_s : 0.0;
   summary["crossed_nodes_max"] = f.crossed_nodes_max;
+  summary["tool_reseats"] = f.tool_reseats;
+  summary["soft_volume_ratio_min"] = f.soft_volume_ratio_min;
+  summary["soft_everted"] = f.soft_volume_ratio_min < 0.0;
   summary["faults"] = f.fault_ticks;
   summary["fault_kinds"] = fault_names(f.fault_bits_seen);
   summary["proxies_rejected"] = proxies_rejected;

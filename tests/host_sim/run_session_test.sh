@@ -29,6 +29,10 @@ if check == "safety":
     if s["proxies_rejected"] != 0: failures.append(f"proxies_rejected = {s['proxies_rejected']}")
     if not s["force_max_n"] <= s["force_limit_n"]: failures.append(f"force_max_n = {s['force_max_n']:.3f} > limit {s['force_limit_n']}")
     if s["ticks"] < 0.99 * s["duration_s"] * s["rt_rate_hz"]: failures.append(f"only {s['ticks']} ticks in {s['duration_s']} s")
+    # A fault-free session has one position epoch (its first sample): one re-seat, never a sweep
+    # from the scene's start pose; and the soft body is never turned inside out.
+    if s["tool_reseats"] != 1: failures.append(f"tool_reseats = {s['tool_reseats']} (a fault-free session has exactly 1)")
+    if not s["soft_volume_ratio_min"] > 0.0: failures.append(f"soft_volume_ratio_min = {s['soft_volume_ratio_min']:.3f}: soft body turned inside out")
     # The session must touch the soft body, or the checks above prove nothing.
     if not s["host_force_max_n"] > 0.1: failures.append(f"host_force_max_n = {s['host_force_max_n']:.3f}: no contact happened")
     if not s["contact_force_max_n"] > 0.1: failures.append(f"contact_force_max_n = {s['contact_force_max_n']:.3f}: rt rendered no contact")
