@@ -11,28 +11,15 @@
 #include <vector>
 
 #include "fissure/host_sim/scene_loader.hpp"
+#include "../host_sim/anchored_scene_fixture.hpp"
 
 namespace fissure::app {
 namespace {
 
 constexpr double kSettle_s = 0.3;
 
-/// The spatula scene with the ball's bottom 1 cm tied to the ground (as the stress cases do).
-host::SceneDescription anchored_spatula_sphere() {
-  host::SceneDescription scene = host::load_scene(host::resolve_scene_path("spatula-sphere"));
-  const host::SoftSphere& sphere = std::get<host::SoftSphere>(scene.soft_body.shape);
-  host::SoftAnchorBox cap;
-  cap.min_world_m = {-0.5, 0.0, -0.5};
-  cap.max_world_m = {0.5, sphere.center_world_m[1] - sphere.radius_m + 0.01, 0.5};
-  scene.soft_body.anchors.push_back(cap);
-  return scene;
-}
-
-double max_distance_m(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b) {
-  double out = 0.0;
-  for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) out = std::max(out, (a[i] - b[i]).norm());
-  return out;
-}
+using host::fixture::anchored_spatula_sphere;
+using host::fixture::max_distance_m;
 
 struct Host {
   explicit Host(const host::SceneDescription& s) : scene(s), session(scene) { session.settle(kSettle_s); }

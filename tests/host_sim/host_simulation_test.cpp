@@ -18,6 +18,8 @@
 #include <BulletDynamics/Dynamics/btRigidBody.h>
 #include <BulletSoftBody/btSoftBody.h>
 
+#include "anchored_scene_fixture.hpp"
+
 namespace fissure::host {
 namespace {
 
@@ -387,22 +389,8 @@ TEST(HostSimulation, ClampOpeningReleasesTheBall) {
 // plate swept 10 cm through the anchored ball and back twice a second, turned it inside out.
 // reseat_tool places the tool there instead.
 
-// The spatula scene with the ball's bottom 1 cm tied to the ground, as the stress cases anchor it.
-SceneDescription anchored_spatula_sphere() {
-  SceneDescription scene = load_scene(resolve_scene_path("spatula-sphere"));
-  const SoftSphere& sphere = std::get<SoftSphere>(scene.soft_body.shape);
-  SoftAnchorBox cap;
-  cap.min_world_m = {-0.5, 0.0, -0.5};
-  cap.max_world_m = {0.5, sphere.center_world_m[1] - sphere.radius_m + 0.01, 0.5};
-  scene.soft_body.anchors.push_back(cap);
-  return scene;
-}
-
-double max_distance_m(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b) {
-  double out = 0.0;
-  for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) out = std::max(out, (a[i] - b[i]).norm());
-  return out;
-}
+using fixture::anchored_spatula_sphere;
+using fixture::max_distance_m;
 
 std::unique_ptr<HostSimulation> settled_sim(const SceneDescription& scene, SceneCollisionMethod method) {
   auto sim = std::make_unique<HostSimulation>(scene, method);
