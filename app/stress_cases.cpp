@@ -541,6 +541,7 @@ class Checker {
       fail("non-finite: host penetration", t_s);
     }
     if (status.crossed_nodes > 0) fail("crossed nodes: soft nodes on the wrong side of the tool", t_s);
+    soft_volume(status.soft_volume_ratio, t_s);  // SessionHost's own per-step figure
     if (!std::isfinite(status.force_n)) fail("non-finite: host force", t_s);
   }
 
@@ -629,9 +630,10 @@ void run_setup(StressSetup& setup, StressRow& row) {
     return;
   }
   host.settle(kSettle_s);
-  const btSoftBody& soft_body = host.simulation().world().soft();
-  const double settled_volume_m3 = soft_body.getVolume();
-  if (!(std::abs(settled_volume_m3) > 0.0)) throw CommandError("stress case '" + row.name + "': the soft body encloses no volume");
+  // The eversion check reads SessionHost's volume ratio (relative to the volume after settle()).
+  if (!(std::abs(host.simulation().world().soft().getVolume()) > 0.0)) {
+    throw CommandError("stress case '" + row.name + "': the soft body encloses no volume");
+  }
 
   LockstepClock clock(0);
   falcon::SimFalcon device(setup.device, clock);
@@ -686,7 +688,6 @@ void run_setup(StressSetup& setup, StressRow& row) {
       // As a split host does (link_bridge.hpp): pause the scene while rt_core is silent.
       if (host_bridge->established() && !host_bridge->peer_silent()) {
         checker.host(host.step(ex->host_state, ex->host_proxy), t_s);
-        checker.soft_volume(soft_body.getVolume() / settled_volume_m3, t_s);
         host_bridge->pump_host(ex->host_state, ex->host_proxy);
       }
     } else {
@@ -701,7 +702,6 @@ void run_setup(StressSetup& setup, StressRow& row) {
         ex->host_state.publish(state);
       }
       checker.host(host.step(ex->host_state, ex->host_proxy), t_s);
-      checker.soft_volume(soft_body.getVolume() / settled_volume_m3, t_s);
       // host → rt: the proxy, with a field overwritten inside a proxy-corruption window.
       if (ex->host_proxy.try_fetch(proxy)) {
         for (const ProxyCorruption& c : setup.proxy_corruptions) {
