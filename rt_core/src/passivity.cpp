@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "fissure/rt_core/safety.hpp"
+
 namespace fissure::rt {
 namespace {
 
@@ -25,13 +27,6 @@ double forgiven_j(const PassivityState& state, double margin_j) noexcept {
   const double owed_j =
       state.recovery_forgiven_j + std::clamp(state.recovery_window_energy_j, 0.0, kPassivityRecoveryForgiveness_j);
   return std::min(owed_j, std::max(0.0, state.energy_j + margin_j));
-}
-
-/// The force as the device renders it: clamped to max_force_n, direction kept (what safety's
-/// clamp makes of it afterwards; the controller must act on this, not on a force never sent).
-Eigen::Vector3d renderable(const Eigen::Vector3d& force_n, double max_force_n) noexcept {
-  const double magnitude = force_n.norm();
-  return magnitude > max_force_n ? Eigen::Vector3d(force_n * (max_force_n / magnitude)) : force_n;
 }
 
 /// Raw speed from which the energy bound acts (passivity.hpp).
@@ -75,7 +70,8 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
     return force_device_n;
   }
   // Everything below works on the force the device will render (passivity.hpp).
-  const Eigen::Vector3d force = renderable(force_device_n, config.max_force_n);
+  // (safety's clamp makes this of it afterwards; the controller must act on it, not on a force never sent)
+  const Eigen::Vector3d force = clamp_force_magnitude(force_device_n, config.max_force_n);
   const Eigen::Vector3d& v = v_filtered_m_per_s;
   const double speed = v.norm();
   const double force_n = force.norm();

@@ -47,6 +47,11 @@ Eigen::Vector3d workspace_soft_wall_n(const SafetyConfig& config, const Eigen::V
   return -config.soft_wall_stiffness_n_per_m * (distance - config.workspace_radius_m) * (from_centre / distance);
 }
 
+Eigen::Vector3d clamp_force_magnitude(const Eigen::Vector3d& force_n, double max_force_n) noexcept {
+  const double magnitude = force_n.norm();
+  return magnitude > max_force_n ? Eigen::Vector3d(force_n * (max_force_n / magnitude)) : force_n;
+}
+
 Eigen::Vector3d apply_safety(const SafetyConfig& config, SafetyState& state, const SafetyInput& input,
                              double period_s, std::uint32_t& flags) noexcept {
   const bool finite = input.force_device_n.allFinite() && input.p_device_m.allFinite();
@@ -63,13 +68,8 @@ Eigen::Vector3d apply_safety(const SafetyConfig& config, SafetyState& state, con
     return Eigen::Vector3d::Zero();
   }
 
-  Eigen::Vector3d force = input.force_device_n;
-
-  const double magnitude = force.norm();
-  if (magnitude > config.max_force_n) {
-    force *= config.max_force_n / magnitude;
-    flags |= kFlagForceClamped;
-  }
+  if (input.force_device_n.norm() > config.max_force_n) flags |= kFlagForceClamped;
+  Eigen::Vector3d force = clamp_force_magnitude(input.force_device_n, config.max_force_n);
 
   advance_ramp(config, state, input.stop_requested, period_s);
   if (state.phase == RampPhase::kStopped) {

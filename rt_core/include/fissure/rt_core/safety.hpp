@@ -85,6 +85,10 @@ void start_ramp_in(SafetyState& state, double ramp_in_s) noexcept;
 Eigen::Vector3d workspace_soft_wall_n(const SafetyConfig& config, const Eigen::Vector3d& p_device_m,
                                       std::uint32_t& flags) noexcept;
 
+/// The magnitude clamp of apply_safety (step 2): force_n scaled down to max_force_n, direction
+/// kept. The passivity controller uses it too, to act on the force the device will render.
+Eigen::Vector3d clamp_force_magnitude(const Eigen::Vector3d& force_n, double max_force_n) noexcept;
+
 /// The last line. Returns the force to command; ORs kFlag*/kFaultNonFinite bits into `flags`.
 Eigen::Vector3d apply_safety(const SafetyConfig& config, SafetyState& state, const SafetyInput& input,
                              double period_s, std::uint32_t& flags) noexcept;
