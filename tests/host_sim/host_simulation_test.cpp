@@ -624,6 +624,70 @@ TEST(Reseat, BulletBoxStartsFromRestAtTheNewPose) {
   EXPECT_NEAR(v_stepped, jump_m / scene.simulation.time_step_s, 0.01 * jump_m / scene.simulation.time_step_s);
 }
 
+// A re-seat while the clamp grips the ball (an encoder jump with the jaws closed). The whole clamp
+// lands 2 mm towards jaw B, so the nodes held on jaw A's inner face are inside jaw A at the new
+// pose, 2 mm from its inner face and 1 mm from its outer one (the jaw is 3 mm thick). They go out
+// on the side they were on before — between the jaws — not through the nearest (outer) face, which
+// would put that part of the ball behind jaw A, outside the grip. The grip then holds: those nodes
+// stay between the jaws, none crossed, both jaws still pressing 0.2 s later.
+TEST(Reseat, ClampGrippingTheBallKeepsItsNodesBetweenTheJaws) {
+  const SceneDescription scene = load_scene(resolve_scene_path("clamp-sphere"));
+  const Vec3& jaw_size_m = scene.tool.clamp.jaw_size_m;
+  constexpr double kReseatTowardsJawBM = 0.002;
+  HostSimulation sim(scene);
+  sim.settle(0.3);
+  // The scripted close, then 0.2 s of its hold: the jaws squeeze the ball.
+  const TrajectoryWaypoint& close = scene.trajectory.waypoints.front();
+  const double close_s = (scene.tool.clamp.jaw_gap_open_m - close.jaw_gap_m) / close.speed_m_per_s;
+  const long close_steps = std::lround((close_s + 0.2) / scene.simulation.time_step_s);
+  TrajectorySample target{};
+  for (long i = 0; i < close_steps; ++i) {
+    target = sim.scripted_target();
+    (void)sim.step(to_tool_pose(target.pose), target.jaw_gap_m);
+  }
+  const double gap_m = sim.last().jaw_gap_m;
+  ASSERT_GT(sim.last().part_force_world_n[0].z(), 0.0) << "jaw A must be gripping before the re-seat";
+  ASSERT_LT(sim.last().part_force_world_n[1].z(), 0.0) << "jaw B must be gripping before the re-seat";
+  // Tool frame: jaw A spans y in [gap/2, gap/2 + thickness], x across it, z along it.
+  const double inner_a_m = 0.5 * gap_m;
+  const double outer_a_m = inner_a_m + jaw_size_m[1];
+  auto in_footprint = [&](const Eigen::Vector3d& p) { return std::abs(p.x()) < 0.5 * jaw_size_m[0] && std::abs(p.z()) < 0.5 * jaw_size_m[2]; };
+  ToolPose pose = to_tool_pose(target.pose);
+  pose.position_world_m = pose.to_world(Eigen::Vector3d(0.0, -kReseatTowardsJawBM, 0.0));
+  std::vector<std::size_t> in_jaw_a;  // inside jaw A at the new pose
+  const std::vector<Eigen::Vector3d> before = sim.node_positions_world_m();
+  for (std::size_t i = 0; i < before.size(); ++i) {
+    const Eigen::Vector3d p = pose.to_tool(before[i]);
+    if (in_footprint(p) && p.y() > inner_a_m && p.y() < outer_a_m) in_jaw_a.push_back(i);
+  }
+  ASSERT_FALSE(in_jaw_a.empty()) << "the nodes held on jaw A must be inside it at the new pose";
+  const int put_out = sim.reseat_tool(pose, gap_m);
+  EXPECT_GE(put_out, static_cast<int>(in_jaw_a.size()));
+  // Largest tool-frame y of those nodes: at most jaw A's inner face while they stay in the grip.
+  auto highest_m = [&]() {
+    double y_max = -1.0;
+    const std::vector<Eigen::Vector3d> x = sim.node_positions_world_m();
+    for (const std::size_t i : in_jaw_a) y_max = std::max(y_max, pose.to_tool(x[i]).y());
+    return y_max;
+  };
+  const double after_reseat_m = highest_m();
+  EXPECT_LE(after_reseat_m, inner_a_m) << "put out between the jaws, not behind jaw A";
+  int crossed_max = 0;
+  double hold_max_m = -1.0;
+  for (int i = 0; i < 200; ++i) {
+    crossed_max = std::max(crossed_max, sim.step(pose, gap_m).crossing.crossed_nodes);
+    hold_max_m = std::max(hold_max_m, highest_m());
+  }
+  std::printf("[reseat] clamp gripping (gap %.1f mm), re-seated %.1f mm towards jaw B: %zu nodes inside jaw A, %d put out, then %.3f mm "
+              "from its inner face (max over 0.2 s %.3f mm; behind it would be > %.1f mm); jaw forces %.3f / %.3f N (z)\n",
+              gap_m * 1e3, kReseatTowardsJawBM * 1e3, in_jaw_a.size(), put_out, (after_reseat_m - inner_a_m) * 1e3, (hold_max_m - inner_a_m) * 1e3,
+              jaw_size_m[1] * 1e3, sim.last().part_force_world_n[0].z(), sim.last().part_force_world_n[1].z());
+  EXPECT_EQ(crossed_max, 0);
+  EXPECT_LE(hold_max_m, inner_a_m) << "those nodes stay between the jaws";
+  EXPECT_GT(sim.last().part_force_world_n[0].z(), 0.0) << "jaw A still grips";
+  EXPECT_LT(sim.last().part_force_world_n[1].z(), 0.0) << "jaw B still grips";
+}
+
 INSTANTIATE_TEST_SUITE_P(Methods, Reseat, ::testing::Values(SceneCollisionMethod::kPaired, SceneCollisionMethod::kBullet),
                          [](const ::testing::TestParamInfo<SceneCollisionMethod>& param_info) {
                            return to_string(param_info.param);
