@@ -113,6 +113,7 @@ struct CollisionData {
   std::vector<std::uint8_t> sweep_plane_had_contact;
   std::vector<std::uint8_t> sweep_plane_open;
   std::vector<std::uint64_t> sweep_contact_words;  // bitset over the tool nodes (orders contact_nodes; all 0 between steps)
+  int sweep_node_tests = 0;  // node tests the last sweep_tool_nodes call ran (tests and measurements count these)
   // Soft faces.
   std::vector<std::int64_t> face_candidate_stamp;
   std::vector<int> candidate_faces;
