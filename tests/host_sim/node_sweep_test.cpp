@@ -1,17 +1,16 @@
 // Stage 2 of the thin-body collision (host_sim/src/thin_body/node_sweep.cpp), tested through its
 // internal interface: the contacts it finds must be exactly those of a brute-force sweep that
-// applies the node test to every tool node in the triangle's footprint (the bins' cells under its
-// swept bounds + contact + memory depth) — the per-plane skip and the per-row cell interval only
-// leave out nodes the node test would drop.
-// (Not asserted: the footprint itself loses a node that touched a triangle at the start of the
-// step and ends far behind it, its projection on the end triangle outside the footprint — a soft
-// surface carried through the tool by more than its thickness within one step. Measured with
-// this test's trials and an every-node brute force, only the steps that carry the sphere through
-// the tool differ: plate 7 / blade 4 / convex spatula 7 of 20 such steps, in 1 to 21 tool nodes;
-// the 0.2 mm-grid plate 2 of 4, in 712 and 2606 nodes. The skips above leave this unchanged.)
+// applies the node test to EVERY tool node against every candidate triangle — no bins, no
+// footprint, no skipping — in every step, including the steps that carry the soft surface through
+// the tool within one step. (Until the footprint was derived from the node test itself, it lost a
+// node that touched a triangle at the start of such a step and ended far behind it: its projection
+// on the end triangle lay outside the triangle's swept bounds + contact + memory depth. This test
+// found it in plate 7 / blade 4 / convex spatula 7 of 20 such steps, 1 to 21 tool nodes each, and
+// in 2 of 4 fine-plate steps, 712 and 2606 nodes.)
 // Random soft surfaces (a 1280-face sphere pressed into / swept past the tool, with every node
 // jittered), random side memory, box tools with rims, a convex spatula, and a fine plate whose
 // bins are clamped at 256 cells per axis (edge cells holding nodes from far outside them).
+// Each suite prints the node tests per step (held / pressing / through), the sweep's cost measure.
 #include "thin_body/collision_state.hpp"
 
 #include <gtest/gtest.h>
@@ -19,7 +18,9 @@
 #include <BulletSoftBody/btSoftBody.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <iostream>
 #include <random>
 #include <string>
 #include <vector>
@@ -66,11 +67,14 @@ bool inside(const Tri& t, const Eigen::Vector3d& p) {
 struct BruteForce {
   std::vector<int> face;
   std::vector<double> tau, facing;
+  // The contact lies, across the bins' axes, outside its triangle's swept bounds + contact distance
+  // + memory depth (the footprint the sweep used to read, which lost such nodes).
+  std::vector<char> beyond_swept_bounds;
 };
 
 BruteForce brute_force(const thin_body::CollisionModel& model, const thin_body::CollisionData& data, const std::vector<int>& face_prev) {
   const auto count = static_cast<std::size_t>(model.tool.node_count());
-  BruteForce out{std::vector<int>(count, -1), std::vector<double>(count, 0.0), std::vector<double>(count, 0.0)};
+  BruteForce out{std::vector<int>(count, -1), std::vector<double>(count, 0.0), std::vector<double>(count, 0.0), std::vector<char>(count, 0)};
   const double contact = model.params.contact_distance_m;
   const double sign = model.soft.outward_sign;
   for (const int face : data.candidate_faces) {
@@ -80,29 +84,12 @@ BruteForce brute_force(const thin_body::CollisionModel& model, const thin_body::
     const Tri start = tri(s(0), s(1), s(2), sign);
     const Tri end = tri(e(0), e(1), e(2), sign);
     if (!start.valid || !end.valid) continue;
-    // The footprint: the tool nodes binned in the cells under the triangle's swept bounds + pad
-    // (node_sweep.cpp's first cut, kept as it was; everything after it must lose nothing).
     Eigen::AlignedBox3d swept;
     for (int k = 0; k < 3; ++k) swept.extend(s(k)).extend(e(k));
     const double pad = contact + model.memory_depth_m;
-    const thin_body::ToolNodeBins& bins = model.bins;
-    const Eigen::AlignedBox3d& tool_bounds = model.tool.bounds_tool_m();
-    if ((swept.min().array() > tool_bounds.max().array() + pad).any() || (swept.max().array() < tool_bounds.min().array() - pad).any()) continue;
-    const auto cell = [&](double x, double origin, int cells) { return std::clamp(static_cast<int>(std::floor((x - origin) / bins.cell_m)), 0, cells - 1); };
-    const int u0 = cell(swept.min()[bins.axis_u] - pad, bins.origin_u, bins.cells_u);
-    const int u1 = cell(swept.max()[bins.axis_u] + pad, bins.origin_u, bins.cells_u);
-    const int v0 = cell(swept.min()[bins.axis_v] - pad, bins.origin_v, bins.cells_v);
-    const int v1 = cell(swept.max()[bins.axis_v] + pad, bins.origin_v, bins.cells_v);
-    if (swept.max()[bins.axis_u] + pad < bins.origin_u || swept.min()[bins.axis_u] - pad > bins.origin_u + bins.cells_u * bins.cell_m ||
-        swept.max()[bins.axis_v] + pad < bins.origin_v || swept.min()[bins.axis_v] - pad > bins.origin_v + bins.cells_v * bins.cell_m)
-      continue;
-    std::vector<char> in_footprint(count, 0);
-    for (int cu = u0; cu <= u1; ++cu)
-      for (int cv = v0; cv <= v1; ++cv)
-        for (int b = bins.begin[static_cast<std::size_t>(cu * bins.cells_v + cv)]; b < bins.begin[static_cast<std::size_t>(cu * bins.cells_v + cv + 1)]; ++b)
-          in_footprint[static_cast<std::size_t>(bins.nodes[static_cast<std::size_t>(b)])] = 1;
+    swept.min().array() -= pad;
+    swept.max().array() += pad;
     for (std::size_t n = 0; n < count; ++n) {
-      if (in_footprint[n] == 0) continue;
       const Eigen::Vector3d& p = model.tool.positions_tool_m()[n];
       const double s_end = end.normal.dot(p - end.a);
       if (s_end > contact) continue;
@@ -116,6 +103,10 @@ BruteForce brute_force(const thin_body::CollisionModel& model, const thin_body::
         out.face[n] = face;
         out.tau[n] = tau;
         out.facing[n] = model.tool.normals_tool()[n].dot(at.normal);
+        const int iu = model.bins.axis_u;
+        const int iv = model.bins.axis_v;
+        out.beyond_swept_bounds[n] =
+            p[iu] < swept.min()[iu] || p[iu] > swept.max()[iu] || p[iv] < swept.min()[iv] || p[iv] > swept.max()[iv] ? 1 : 0;
       }
     }
   }
@@ -141,9 +132,15 @@ Eigen::Matrix3d random_rotation(std::mt19937& rng) {
   return Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix();
 }
 
+// What a comparison saw (so a test can check it exercised something): tool-node contacts, and
+// those beyond their triangle's swept bounds + contact + memory depth.
+struct Seen {
+  int contacts = 0;
+  int beyond_swept_bounds = 0;
+};
+
 // Runs `trials` random steps through sweep_tool_nodes and the brute force and compares them.
-// Returns the number of tool-node contacts seen (so a test can check it exercised something).
-int compare_with_brute_force(const ToolNodes& tool, int trials, unsigned seed, const std::string& label, int sphere_resolution = 639) {
+Seen compare_with_brute_force(const ToolNodes& tool, int trials, unsigned seed, const std::string& label, int sphere_resolution = 639) {
   test_scene::SoftWorld world(true);
   world.add_sphere(test_scene::kSphereRadius_m, sphere_resolution);  // 639: 1280 faces; 63: 128
   const btSoftBody& soft = world.soft();
@@ -156,7 +153,12 @@ int compare_with_brute_force(const ToolNodes& tool, int trials, unsigned seed, c
   const double r = test_scene::kSphereRadius_m;
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  int contacts_seen = 0;
+  Seen seen;
+  // Node tests per step by kind (held / pressing / through), all steps and the unjittered ones.
+  std::array<long, 3> node_tests_by_kind{};
+  std::array<int, 3> trials_by_kind{};
+  std::array<long, 3> rigid_node_tests_by_kind{};
+  std::array<int, 3> rigid_trials_by_kind{};
   for (int trial = 0; trial < trials; ++trial) {
     ++data.step;
     // Start and end: the sphere pressed into the tool's +w face (depths −2 … +8 mm), sometimes
@@ -195,10 +197,17 @@ int compare_with_brute_force(const ToolNodes& tool, int trials, unsigned seed, c
     std::fill(data.node_age.begin(), data.node_age.end(), 1);  // so that the expected ages are 2 (held on) or 1 (new)
     const BruteForce expected = brute_force(model, data, face_prev);
     thin_body::sweep_tool_nodes(model, data);
+    node_tests_by_kind[static_cast<std::size_t>(kind)] += data.sweep_node_tests;
+    ++trials_by_kind[static_cast<std::size_t>(kind)];
+    if (jitter == 0.0) {
+      rigid_node_tests_by_kind[static_cast<std::size_t>(kind)] += data.sweep_node_tests;
+      ++rigid_trials_by_kind[static_cast<std::size_t>(kind)];
+    }
     int contacts = 0;
     int mismatches = 0;
     for (std::size_t n = 0; n < expected.face.size(); ++n) {
       contacts += expected.face[n] >= 0 ? 1 : 0;
+      seen.beyond_swept_bounds += expected.face[n] >= 0 && expected.beyond_swept_bounds[n] != 0 ? 1 : 0;
       const bool same = data.node_face[n] == expected.face[n] &&
                         (expected.face[n] < 0 || (data.node_tau[n] == expected.tau[n] && data.node_facing[n] == expected.facing[n]));
       if (!same && mismatches++ < 3)
@@ -213,17 +222,26 @@ int compare_with_brute_force(const ToolNodes& tool, int trials, unsigned seed, c
     EXPECT_EQ(data.contact_nodes, listed) << label << " trial " << trial;
     for (const int n : listed)
       EXPECT_EQ(data.node_age[static_cast<std::size_t>(n)], face_prev[static_cast<std::size_t>(n)] >= 0 ? 2 : 1) << label << " node " << n;
-    contacts_seen += contacts;
+    seen.contacts += contacts;
   }
-  return contacts_seen;
+  const auto per_step = [](const std::array<long, 3>& tests, const std::array<int, 3>& steps, std::size_t kind) {
+    return tests[kind] / std::max(1, steps[kind]);
+  };
+  std::cout << label << " (" << tool.node_count() << " tool nodes): node tests per step held / pressing / through the tool "
+            << per_step(node_tests_by_kind, trials_by_kind, 0) << " / " << per_step(node_tests_by_kind, trials_by_kind, 1) << " / "
+            << per_step(node_tests_by_kind, trials_by_kind, 2) << "; without node jitter " << per_step(rigid_node_tests_by_kind, rigid_trials_by_kind, 0)
+            << " / " << per_step(rigid_node_tests_by_kind, rigid_trials_by_kind, 1) << " / " << per_step(rigid_node_tests_by_kind, rigid_trials_by_kind, 2)
+            << "\n";
+  return seen;
 }
 
 TEST(NodeSweep, PlateWithRimsFindsExactlyTheBruteForceContacts) {
   BoxToolShape shape;
   shape.half_extents_m = Eigen::Vector3d(0.05, 0.001, 0.05);  // the bench's 100 × 2 × 100 mm plate, 2 mm grid
   shape.nodes_u = shape.nodes_v = 51;
-  const int contacts = compare_with_brute_force(ToolNodes::from_box(shape), 60, 11U, "plate");
-  EXPECT_GT(contacts, 1000) << "the random steps must produce contacts to compare";
+  const Seen seen = compare_with_brute_force(ToolNodes::from_box(shape), 60, 11U, "plate");
+  EXPECT_GT(seen.contacts, 1000) << "the random steps must produce contacts to compare";
+  EXPECT_GT(seen.beyond_swept_bounds, 0) << "the steps through the tool must produce contacts the old footprint lost";
 }
 
 TEST(NodeSweep, ThinAxisAlongXFindsExactlyTheBruteForceContacts) {
@@ -232,15 +250,17 @@ TEST(NodeSweep, ThinAxisAlongXFindsExactlyTheBruteForceContacts) {
   shape.thin_axis = 0;
   shape.nodes_u = 31;
   shape.nodes_v = 21;
-  const int contacts = compare_with_brute_force(ToolNodes::from_box(shape), 60, 12U, "blade");
-  EXPECT_GT(contacts, 300);
+  const Seen seen = compare_with_brute_force(ToolNodes::from_box(shape), 60, 12U, "blade");
+  EXPECT_GT(seen.contacts, 300);
+  EXPECT_GT(seen.beyond_swept_bounds, 0);
 }
 
 TEST(NodeSweep, ConvexSpatulaFindsExactlyTheBruteForceContacts) {
   RoundedSpatulaParams params;  // 40 × 40 × 2 mm, rounded rims: tilted planes
-  const int contacts = compare_with_brute_force(ToolNodes::from_convex_mesh(make_rounded_spatula_mesh(params, 3.0 * params.thickness_m)), 60, 13U,
-                                                "convex spatula");
-  EXPECT_GT(contacts, 100);
+  const Seen seen = compare_with_brute_force(ToolNodes::from_convex_mesh(make_rounded_spatula_mesh(params, 3.0 * params.thickness_m)), 60, 13U,
+                                             "convex spatula");
+  EXPECT_GT(seen.contacts, 100);
+  EXPECT_GT(seen.beyond_swept_bounds, 0);
 }
 
 TEST(NodeSweep, BinsClampedAt256CellsFindExactlyTheBruteForceContacts) {
@@ -256,8 +276,9 @@ TEST(NodeSweep, BinsClampedAt256CellsFindExactlyTheBruteForceContacts) {
   world.add_sphere(test_scene::kSphereRadius_m, 63);
   const thin_body::CollisionModel model = thin_body::build_collision_model(tool, world.soft(), params, true);
   ASSERT_EQ(model.bins.cells_u, 256) << "premise: the bins are clamped";
-  const int contacts = compare_with_brute_force(tool, 12, 14U, "fine plate", 63);
-  EXPECT_GT(contacts, 1000);
+  const Seen seen = compare_with_brute_force(tool, 12, 14U, "fine plate", 63);
+  EXPECT_GT(seen.contacts, 1000);
+  EXPECT_GT(seen.beyond_swept_bounds, 0);
 }
 
 }  // namespace
