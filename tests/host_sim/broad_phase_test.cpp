@@ -10,6 +10,7 @@
 #include <BulletSoftBody/btSoftBody.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 #include <iterator>
@@ -99,6 +100,25 @@ void expect_between(const std::set<int>& got, const FaceSets& sets, const std::s
   std::set_difference(got.begin(), got.end(), sets.allowed.begin(), sets.allowed.end(), std::back_inserter(extra));
   EXPECT_TRUE(missing.empty()) << where << ": " << missing.size() << " needed faces missing, first " << (missing.empty() ? -1 : missing[0]);
   EXPECT_TRUE(extra.empty()) << where << ": " << extra.size() << " candidates not allowed, first " << (extra.empty() ? -1 : extra[0]);
+}
+
+// The pre-filter (broad_phase.cpp, header comment 3.) may only skip work, never change a decision:
+// among the faces the broad phase reached this step (face_candidate_stamp == step), the candidates
+// must be exactly the ALLOWED ones (the exact tool-frame test, brute force) — a face the exact test
+// keeps but the pre-filter dropped would be missing here even where brute force does not call it
+// needed.
+void expect_reached_faces_decided_exactly(const thin_body::CollisionData& data, std::int64_t step, const FaceSets& sets, const std::string& where) {
+  const std::set<int> got(data.candidate_faces.begin(), data.candidate_faces.end());
+  int wrong = 0, first = -1;
+  for (int f = 0; f < static_cast<int>(data.face_candidate_stamp.size()); ++f) {
+    const bool reached = data.face_candidate_stamp[static_cast<std::size_t>(f)] == step;
+    const bool expected = reached && sets.allowed.count(f) != 0;
+    if (expected != (got.count(f) != 0)) {
+      ++wrong;
+      if (first < 0) first = f;
+    }
+  }
+  EXPECT_EQ(wrong, 0) << where << ": " << wrong << " reached faces decided unlike the exact test, first " << first;
 }
 
 struct Harness {
@@ -201,6 +221,7 @@ TEST(BroadPhase, RandomPosesGiveEveryNeededFaceAndNoOther) {
       const thin_body::StepFrame used = h.step(previous, current, false);
       ASSERT_EQ(used.step, frame.step);
       expect_between(h.candidate_faces(), expected, std::to_string(faces) + " faces, trial " + std::to_string(trial));
+      expect_reached_faces_decided_exactly(h.data, used.step, expected, std::to_string(faces) + " faces, trial " + std::to_string(trial));
       expect_candidate_nodes_are_the_vertices(h, used);
       poses_with_candidates += expected.needed.empty() ? 0 : 1;
     }
@@ -227,6 +248,7 @@ TEST(BroadPhase, PlungesAndHoldsGiveEveryNeededFaceAndNoOther) {
       const FaceSets expected = needed_faces(h.model, h.data, frame, h.world.soft(), memory);
       (void)h.step(previous, current, true);
       expect_between(h.candidate_faces(), expected, "speed " + std::to_string(speed) + " step " + std::to_string(s));
+      expect_reached_faces_decided_exactly(h.data, frame.step, expected, "speed " + std::to_string(speed) + " step " + std::to_string(s));
       if (HasFailure()) return;
       contact_steps += h.data.contact_nodes.empty() ? 0 : 1;
       previous = current;
@@ -284,6 +306,106 @@ TEST(BroadPhase, NodesMovedAfterBulletFittedTheirLeavesAreStillFound) {
     ASSERT_FALSE(expected.needed.empty());
     (void)h.step(pose, pose, false);
     expect_between(h.candidate_faces(), expected, std::to_string(faces) + " faces, " + std::to_string(outside_leaf_m * 1e3) + " mm outside a leaf");
+    expect_reached_faces_decided_exactly(h.data, frame.step, expected, std::to_string(faces) + " faces, sprung-back cap");
+  }
+}
+
+// The pre-filter's edge cases, each a face that ONLY the exact tool-frame test keeps for its own
+// reason, with the tool turning 0.12 rad within the step (start and end in different frames) and
+// tilted 0.7 rad: (a) a stretched triangle whose tool-frame bounds meet the padded tool while its
+// three vertices and the triangle itself stay clear of it; (b) a face 1.5 mm under the plate
+// (outside contact_distance + skin) with a vertex held on the tool last step (the release band);
+// (c) the same face under tool nodes that were in contact last step (the side-memory band). Each
+// must be a candidate, and must not be one without its reason (the control); every reached face
+// must be decided as the exact test decides.
+TEST(BroadPhase, PreFilterKeepsEveryFaceTheExactTestKeeps) {
+  enum class Reason { kStretchedAcrossTheRim, kHeldVertexInReleaseBand, kMemoryBand };
+  const ToolNodes plate = test_scene::plate_tool(0.002);
+  const Eigen::AlignedBox3d bounds = plate.bounds_tool_m();
+  const double half_x = bounds.max().x(), top = bounds.max().y(), bottom = bounds.min().y();
+  for (const Reason reason : {Reason::kStretchedAcrossTheRim, Reason::kHeldVertexInReleaseBand, Reason::kMemoryBand}) {
+    for (const bool with_reason : {true, false}) {
+      Harness h(1280, plate);
+      h.world.step_without_dynamics();
+      btSoftBody& soft = h.world.soft();
+      // The topmost face of the sphere is the one moved into place.
+      int face = 0;
+      double best = -1.0;
+      for (int f = 0; f < h.model.soft.face_count; ++f) {
+        double y = 0.0;
+        for (const int v : h.model.soft.face_nodes[static_cast<std::size_t>(f)]) y += soft.m_nodes[v].m_x.y() / 3.0;
+        if (y > best) best = y, face = f;
+      }
+      const std::array<int, 3> nodes = h.model.soft.face_nodes[static_cast<std::size_t>(face)];
+      std::array<Eigen::Vector3d, 3> p_tool;
+      switch (reason) {
+        case Reason::kStretchedAcrossTheRim:
+          // In the plane x + y = half_x + top + 0.5 mm: 0.35 mm clear of the rim edge (x = half_x,
+          // y = top), with tool-frame bounds [half_x − 1, half_x + 1.5] × [top − 1, top + 1.5] mm
+          // that take in the rim. Without the reason: the same triangle 3 mm further out.
+          p_tool = {Eigen::Vector3d(half_x - 0.001, top + 0.0015, 0.0), Eigen::Vector3d(half_x + 0.0015, top - 0.001, 0.0),
+                    Eigen::Vector3d(half_x + 0.0015, top - 0.001, 0.001)};
+          if (!with_reason)
+            for (Eigen::Vector3d& p : p_tool) p += Eigen::Vector3d(0.003, 0.003, 0.0);
+          break;
+        case Reason::kHeldVertexInReleaseBand:
+        case Reason::kMemoryBand:
+          // 1.5-2.5 mm under the plate's bottom, under its middle.
+          p_tool = {Eigen::Vector3d(0.0, bottom - 0.0015, 0.0), Eigen::Vector3d(0.001, bottom - 0.0025, 0.0),
+                    Eigen::Vector3d(0.0, bottom - 0.0025, 0.001)};
+          break;
+      }
+      // Tool poses that put those points where the face was (the sphere's other faces do not matter).
+      Eigen::Vector3d centroid_world = Eigen::Vector3d::Zero();
+      for (const int v : nodes) centroid_world += to_eigen(soft.m_nodes[v].m_x) / 3.0;
+      const Eigen::Vector3d centroid_tool = (p_tool[0] + p_tool[1] + p_tool[2]) / 3.0;
+      ToolPose previous, current;
+      previous.orientation_world = Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1.0, 0.3, -0.4).normalized()));
+      current.orientation_world = (Eigen::Quaterniond(Eigen::AngleAxisd(0.12, Eigen::Vector3d(-0.2, 1.0, 0.5).normalized())) *
+                                   previous.orientation_world).normalized();
+      previous.position_world_m = centroid_world - previous.orientation_world * centroid_tool;
+      current.position_world_m = centroid_world - current.orientation_world * centroid_tool + Eigen::Vector3d(0.0004, -0.0003, 0.0002);
+      // Fixed in the tool frame over the step: start (m_q) at the previous pose, end (m_x) at the current one.
+      for (std::size_t k = 0; k < 3; ++k) {
+        const Eigen::Vector3d q = previous.to_world(p_tool[k]), x = current.to_world(p_tool[k]);
+        btSoftBody::Node& n = soft.m_nodes[nodes[k]];
+        n.m_q = btVector3(static_cast<btScalar>(q.x()), static_cast<btScalar>(q.y()), static_cast<btScalar>(q.z()));
+        n.m_x = btVector3(static_cast<btScalar>(x.x()), static_cast<btScalar>(x.y()), static_cast<btScalar>(x.z()));
+      }
+      h.data.contact_nodes.clear();
+      std::fill(h.data.node_face.begin(), h.data.node_face.end(), -1);
+      if (reason == Reason::kHeldVertexInReleaseBand && with_reason) h.data.hold_stamp[static_cast<std::size_t>(nodes[0])] = h.data.step;
+      if (reason == Reason::kMemoryBand && with_reason) {
+        // Bottom-face tool nodes within 3 mm of the face's footprint were in contact last step.
+        for (int n = 0; n < plate.node_count(); ++n) {
+          const Eigen::Vector3d& p = plate.positions_tool_m()[static_cast<std::size_t>(n)];
+          if (p.y() < bottom + 1e-9 && std::abs(p.x()) < 0.003 && std::abs(p.z()) < 0.003) {
+            h.data.contact_nodes.push_back(n);
+            h.data.node_face[static_cast<std::size_t>(n)] = face;
+          }
+        }
+        ASSERT_FALSE(h.data.contact_nodes.empty());
+      }
+      const std::string where = std::string(reason == Reason::kStretchedAcrossTheRim ? "stretched across the rim"
+                                            : reason == Reason::kHeldVertexInReleaseBand ? "held vertex" : "memory band") +
+                                (with_reason ? "" : " (control)");
+      // Preconditions: no vertex, start or end, within contact_distance + skin of the tool.
+      const thin_body::StepFrame frame = make_frame(h.model, h.data.step + 1, previous, current);
+      const Eigen::AlignedBox3d near = grown(bounds, h.params.contact_distance_m + h.params.skin_m);
+      for (const int v : nodes) {
+        const Eigen::Vector3d start = frame.r_prev.transpose() * (to_eigen(soft.m_nodes[v].m_q) - frame.t_prev);
+        const Eigen::Vector3d end = frame.r_cur.transpose() * (to_eigen(soft.m_nodes[v].m_x) - frame.t_cur);
+        ASSERT_FALSE(near.contains(start)) << where;
+        ASSERT_FALSE(near.contains(end)) << where;
+      }
+      const FaceSets expected = needed_faces(h.model, h.data, frame, soft, h.last_contact_nodes());
+      ASSERT_EQ(expected.allowed.count(face) != 0, with_reason) << where << ": the exact test must keep the face for its reason only";
+      (void)h.step(previous, current, false);
+      EXPECT_EQ(h.data.face_candidate_stamp[static_cast<std::size_t>(face)], frame.step) << where << ": the face must be reached";
+      EXPECT_EQ(h.candidate_faces().count(face) != 0, with_reason) << where;
+      expect_between(h.candidate_faces(), expected, where);
+      expect_reached_faces_decided_exactly(h.data, frame.step, expected, where);
+    }
   }
 }
 
@@ -307,7 +429,7 @@ TEST(BroadPhase, OutOfContactNoFaceIsTested) {
 // (16× more faces from 1280 to 20480); the scan reads every node once, nothing more.
 TEST(BroadPhase, WorkForAFixedContactDoesNotGrowWithTheMesh) {
   struct Work {
-    int faces, candidates, scanned, seeds, tested;
+    int faces, candidates, scanned, seeds, tested, transformed;
   };
   std::vector<Work> rows;
   for (const int faces : {1280, 5120, 20480}) {
@@ -328,14 +450,18 @@ TEST(BroadPhase, WorkForAFixedContactDoesNotGrowWithTheMesh) {
     h.data.broad_previous_candidates.clear();  // measure one step's own work, not the re-test of the last
     (void)h.step(pose, pose, false);
     rows.push_back({faces, static_cast<int>(h.data.candidate_faces.size()), h.data.broad_nodes_scanned, h.data.broad_seed_nodes,
-                    h.data.broad_faces_tested});
-    std::printf("faces %6d: candidate faces %4d, nodes scanned %5d, seed nodes %5d, faces tested %5d\n", faces, rows.back().candidates,
-                rows.back().scanned, rows.back().seeds, rows.back().tested);
+                    h.data.broad_faces_tested, h.data.broad_faces_transformed});
+    std::printf("faces %6d: candidate faces %4d, nodes scanned %5d, seed nodes %5d, faces tested %5d, transformed %4d\n", faces,
+                rows.back().candidates, rows.back().scanned, rows.back().seeds, rows.back().tested, rows.back().transformed);
     EXPECT_EQ(rows.back().scanned, h.model.soft.node_count);
   }
   for (const Work& w : rows) {
     EXPECT_GE(w.candidates, 24);
     EXPECT_LE(w.candidates, 100);
+    // The pre-filter: only faces near the tool get their vertices into the tool frame, not the
+    // seed band (a plate held still on the sphere: its pre-filter is exact).
+    EXPECT_GE(w.transformed, w.candidates);
+    EXPECT_LE(w.transformed, 2 * w.candidates);
   }
   const auto per_candidate = [](const Work& w, int count) { return static_cast<double>(count) / w.candidates; };
   const Work& coarse = rows.front();

@@ -45,12 +45,25 @@
 //      the icospheres (2 % fewer seeds), not worth a table.
 //   2. The faces around last step's candidate nodes are re-tested directly: a node held on the tool
 //      last step keeps its faces for the release band even where the seed query does not reach.
+//   3. Most faces reached through the seeds lie in the seed band only and are rejected (bench
+//      collision's 20 480-face same_contact hold: 247 seeds reach 552 faces for 24 candidates).
+//      Each reached face is first tested from its vertices' WORLD bounds (m_q box, m_x box, in
+//      Bullet's float with SIMD), carried into the tool frame whole (Arvo's box transform, see
+//      ToolFrameBounds): every tool-frame start/end position of a vertex lies in those carried
+//      boxes, so a face they keep away from every query is one the exact test would reject — the
+//      candidate set is unchanged (tests/host_sim/broad_phase_test.cpp: brute force, every reached
+//      face decided as the exact test decides, and rotated / stretched / held / memory cases at
+//      the pre-filter's edge). Only the faces it keeps (24 of the 552 there) get their vertices
+//      transformed into the tool frame and stamped. Measured on that hold (a driver stepping it,
+//      3 interleaved runs, load 6-12): broad stage 135-145 µs before, 130-135 after; the band is
+//      memory latency (a few lines per face and vertex, cold after Bullet's step), not arithmetic.
 // Out of contact: the scan finds no seed; nothing else runs.
 #include "collision_state.hpp"
 
 #include <BulletSoftBody/btSoftBody.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -141,31 +154,134 @@ Query make_query(const CollisionModel& model, const StepFrame& frame, const Coll
   return q;
 }
 
+// A world box carried into the tool frame at the previous / current pose (Arvo, "Transforming
+// axis-aligned bounding boxes", Graphics Gems 1990): the centre by Rᵀ, the half-sizes by |Rᵀ|.
+// Every point of the world box lands inside the result; for a tool whose axes are the world's (or
+// a signed permutation of them) the result is the bounds of the transformed box. In Bullet's
+// single precision with SIMD btVector3 (the pre-filter runs on every face of the band): each
+// result is grown by kFloatSlack times the magnitudes involved, which bounds the float rounding
+// (≤ ~20 ε ≈ 1.2e-6 of them, ε = 2⁻²⁴), so the box still holds every double-precision position
+// the exact test computes.
+class ToolFrameBounds {
+ public:
+  explicit ToolFrameBounds(const StepFrame& frame)
+      : prev_(frame.r_prev, frame.t_prev), cur_(frame.r_cur, frame.t_cur) {}
+
+  struct Box {
+    btVector3 lo, hi;
+  };
+  Box start(const btVector3& lo, const btVector3& hi) const { return prev_.carried(lo, hi); }
+  Box end(const btVector3& lo, const btVector3& hi) const { return cur_.carried(lo, hi); }
+
+ private:
+  static constexpr btScalar kFloatSlack = 1e-5f;
+
+  struct Pose {
+    btVector3 rt_col[3], abs_rt_col[3], t;  // columns of Rᵀ and |Rᵀ|; the origin
+    btScalar t_magnitude;
+    Pose(const Eigen::Matrix3d& r, const Eigen::Vector3d& origin) {
+      for (int c = 0; c < 3; ++c) {
+        // Column c of Rᵀ is row c of R.
+        rt_col[c] = btVector3(static_cast<btScalar>(r(c, 0)), static_cast<btScalar>(r(c, 1)), static_cast<btScalar>(r(c, 2)));
+        abs_rt_col[c] = rt_col[c].absolute();
+      }
+      t = btVector3(static_cast<btScalar>(origin.x()), static_cast<btScalar>(origin.y()), static_cast<btScalar>(origin.z()));
+      t_magnitude = static_cast<btScalar>(origin.cwiseAbs().maxCoeff());
+    }
+    Box carried(const btVector3& lo, const btVector3& hi) const {
+      const btVector3 centre = (lo + hi) * btScalar(0.5) - t;
+      const btVector3 half = (hi - lo) * btScalar(0.5);
+      const btVector3 c = rt_col[0] * centre.x() + rt_col[1] * centre.y() + rt_col[2] * centre.z();
+      const btVector3 magnitude_lo = lo.absolute(), magnitude_hi = hi.absolute();
+      const btScalar magnitude = std::max(magnitude_lo[magnitude_lo.maxAxis()], magnitude_hi[magnitude_hi.maxAxis()]) + t_magnitude;
+      const btScalar slack = kFloatSlack * magnitude;
+      const btVector3 h = abs_rt_col[0] * half.x() + abs_rt_col[1] * half.y() + abs_rt_col[2] * half.z() + btVector3(slack, slack, slack);
+      return {c - h, c + h};
+    }
+  };
+  Pose prev_, cur_;
+};
+
+// A tool-frame query box in float, rounded outwards (the pre-filter compares float boxes).
+struct FloatBox {
+  btVector3 lo, hi;
+  bool empty = true;
+  static FloatBox of(const Eigen::AlignedBox3d& box) {
+    FloatBox out;
+    if (box.isEmpty()) return out;
+    const auto below = [](double v) { return std::nextafter(static_cast<float>(v), -std::numeric_limits<float>::infinity()); };
+    const auto above = [](double v) { return std::nextafter(static_cast<float>(v), std::numeric_limits<float>::infinity()); };
+    out.lo = btVector3(below(box.min().x()), below(box.min().y()), below(box.min().z()));
+    out.hi = btVector3(above(box.max().x()), above(box.max().y()), above(box.max().z()));
+    out.empty = false;
+    return out;
+  }
+  bool meets(const btVector3& lo_other, const btVector3& hi_other) const {
+    return !empty && lo_other.x() <= hi.x() && lo_other.y() <= hi.y() && lo_other.z() <= hi.z() && hi_other.x() >= lo.x() &&
+           hi_other.y() >= lo.y() && hi_other.z() >= lo.z();
+  }
+};
+
 class Collector {
  public:
   Collector(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, const Query& query, CollisionData& data)
-      : model_(model), frame_(frame), soft_(soft), query_(query), data_(data) {}
+      : model_(model), frame_(frame), soft_(soft), query_(query), data_(data), bounds_(frame),
+        near_(FloatBox::of(query.near_tool)), memory_(FloatBox::of(query.memory_tool)), release_(FloatBox::of(query.release_tool)) {}
 
-  // A node whose own start/end box meets the world query: test every face around it.
-  void seed_if_near(int node) {
+  // A seed: a node whose own start/end box meets the world query (every face around it is reached).
+  bool is_seed(int node) const {
     const btSoftBody::Node& n = soft_.m_nodes[node];
     Eigen::AlignedBox3d box(to_eigen(n.m_x));
     box.extend(to_eigen(n.m_q));
-    if (!query_.seed(box)) return;
-    ++data_.broad_seed_nodes;
-    test_faces_around(node);
+    return query_.seed(box);
   }
 
-  void test_faces_around(int node) {
+  // Every face around a seed or around last step's candidate (whatever its leaf says), once a step.
+  void reach_faces_around(int node) {
     const auto n = static_cast<std::size_t>(node);
     for (int k = model_.soft.faces_of_node_begin[n]; k < model_.soft.faces_of_node_begin[n + 1]; ++k)
-      test_face(model_.soft.faces_of_node[static_cast<std::size_t>(k)]);
+      prefilter_face(model_.soft.faces_of_node[static_cast<std::size_t>(k)]);
   }
 
-  // Last step's candidate: every face around it, whatever its leaf says.
-  void retest_previous(int node) { test_faces_around(node); }
+  // The exact test of every face the pre-filter kept, in the order they were reached.
+  void test_kept_faces() {
+    for (const int face : data_.broad_faces_kept) test_face(face);
+  }
 
  private:
+
+  // Each face once a step: kept for the exact test unless its vertices' world bounds, carried
+  // into the tool frame, keep it away from every query (header comment, 3.). It reads only
+  // Bullet's node positions: no transform, no stamp.
+  void prefilter_face(int face) {
+    const auto f = static_cast<std::size_t>(face);
+    if (data_.face_candidate_stamp[f] == frame_.step) return;
+    data_.face_candidate_stamp[f] = frame_.step;
+    ++data_.broad_faces_tested;
+    const std::array<int, 3>& v = model_.soft.face_nodes[f];
+    const btSoftBody::Node& a = soft_.m_nodes[v[0]];
+    const btSoftBody::Node& b = soft_.m_nodes[v[1]];
+    const btSoftBody::Node& c = soft_.m_nodes[v[2]];
+    btVector3 q_lo = a.m_q, q_hi = a.m_q, x_lo = a.m_x, x_hi = a.m_x;
+    q_lo.setMin(b.m_q), q_lo.setMin(c.m_q), q_hi.setMax(b.m_q), q_hi.setMax(c.m_q);
+    x_lo.setMin(b.m_x), x_lo.setMin(c.m_x), x_hi.setMax(b.m_x), x_hi.setMax(c.m_x);
+    const ToolFrameBounds::Box end_tool = bounds_.end(x_lo, x_hi);
+    ToolFrameBounds::Box box_tool = bounds_.start(q_lo, q_hi);
+    box_tool.lo.setMin(end_tool.lo);
+    box_tool.hi.setMax(end_tool.hi);
+    // The held-vertex band: its end position lies in end_tool, so a vertex inside release_tool
+    // needs end_tool to meet it; the hold stamps are read only then.
+    if (near_.meets(box_tool.lo, box_tool.hi) || memory_.meets(box_tool.lo, box_tool.hi) ||
+        (release_.meets(end_tool.lo, end_tool.hi) && has_vertex_held_last_step(f)))
+      data_.broad_faces_kept.push_back(face);
+  }
+
+  bool has_vertex_held_last_step(std::size_t face) const {
+    for (const int vertex : model_.soft.face_nodes[face])
+      if (data_.hold_stamp[static_cast<std::size_t>(vertex)] == frame_.step - 1) return true;
+    return false;
+  }
+
   void transform(int node) {
     const auto i = static_cast<std::size_t>(node);
     if (data_.soft_stamp[i] == frame_.step) return;
@@ -184,11 +300,10 @@ class Collector {
     return false;
   }
 
+  // The exact test: the face's tool-frame start/end bounds against the queries.
   void test_face(int face) {
     const auto f = static_cast<std::size_t>(face);
-    if (data_.face_candidate_stamp[f] == frame_.step) return;
-    data_.face_candidate_stamp[f] = frame_.step;
-    ++data_.broad_faces_tested;
+    ++data_.broad_faces_transformed;
     Eigen::AlignedBox3d box_tool;
     for (const int vertex : model_.soft.face_nodes[f]) {
       transform(vertex);
@@ -210,37 +325,59 @@ class Collector {
   const btSoftBody& soft_;
   const Query& query_;
   CollisionData& data_;
+  const ToolFrameBounds bounds_;
+  const FloatBox near_, memory_, release_;  // query_'s tool-frame boxes in float, rounded outwards
 };
 
-// The three dependent levels of data the face tests read, one level at a time for all nodes.
+// GCC deletes a loop whose body only prefetches (-ffinite-loops, on by default for C++ at -O2:
+// __builtin_prefetch has no side effect, so such a loop counts as doing nothing): objdump showed
+// the staged prefetches below compiled to no instruction at all before this. The empty volatile
+// asm is a side effect the optimiser must keep, so the loops and their prefetches stay.
+inline void prefetch(const void* address) {
+  __builtin_prefetch(address);
+  asm volatile("");
+}
+
+// The three dependent levels of data the pre-filter reads, one level at a time for all nodes.
 void prefetch_faces_around(const CollisionModel& model, const btSoftBody& soft, const CollisionData& data, const std::vector<int>& nodes) {
   const SoftSurfaceModel& surface = model.soft;
-  for (const int node : nodes) __builtin_prefetch(&surface.faces_of_node_begin[static_cast<std::size_t>(node)]);
+  for (const int node : nodes) prefetch(&surface.faces_of_node_begin[static_cast<std::size_t>(node)]);
   for (const int node : nodes) {
     const auto n = static_cast<std::size_t>(node);
     if (surface.faces_of_node_begin[n] < surface.faces_of_node_begin[n + 1])
-      __builtin_prefetch(&surface.faces_of_node[static_cast<std::size_t>(surface.faces_of_node_begin[n])]);
+      prefetch(&surface.faces_of_node[static_cast<std::size_t>(surface.faces_of_node_begin[n])]);
   }
   for (const int node : nodes) {
     const auto n = static_cast<std::size_t>(node);
     for (int k = surface.faces_of_node_begin[n]; k < surface.faces_of_node_begin[n + 1]; ++k) {
       const auto f = static_cast<std::size_t>(surface.faces_of_node[static_cast<std::size_t>(k)]);
-      __builtin_prefetch(&surface.face_nodes[f]);
-      __builtin_prefetch(&data.face_candidate_stamp[f]);
+      prefetch(&surface.face_nodes[f]);
+      prefetch(&data.face_candidate_stamp[f]);
     }
   }
   for (const int node : nodes) {
     const auto n = static_cast<std::size_t>(node);
     for (int k = surface.faces_of_node_begin[n]; k < surface.faces_of_node_begin[n + 1]; ++k) {
       for (const int vertex : surface.face_nodes[static_cast<std::size_t>(surface.faces_of_node[static_cast<std::size_t>(k)])]) {
-        const auto v = static_cast<std::size_t>(vertex);
-        __builtin_prefetch(&soft.m_nodes[vertex].m_x);
-        __builtin_prefetch(&data.soft_stamp[v]);
-        __builtin_prefetch(&data.start_tool_m[v]);
-        __builtin_prefetch(&data.end_tool_m[v]);
-        __builtin_prefetch(&data.hold_stamp[v]);
-        __builtin_prefetch(&data.broad_listed_stamp[v]);
+        // m_x and m_q are 16 bytes apart but may straddle a cache line (they do on the bench's
+        // 20 480-face sphere: m_x at 48 mod 64).
+        prefetch(&soft.m_nodes[vertex].m_x);
+        prefetch(&soft.m_nodes[vertex].m_q);
       }
+    }
+  }
+}
+
+// What the exact test reads and writes for the vertices of the faces the pre-filter kept.
+void prefetch_kept_faces(const CollisionModel& model, const CollisionData& data) {
+  for (const int face : data.broad_faces_kept) {
+    for (const int vertex : model.soft.face_nodes[static_cast<std::size_t>(face)]) {
+      const auto v = static_cast<std::size_t>(vertex);
+      prefetch(&data.soft_stamp[v]);
+      prefetch(&data.start_tool_m[v]);
+      prefetch(&data.end_tool_m[v]);
+      prefetch(&data.hold_stamp[v]);
+      prefetch(&data.broad_listed_stamp[v]);
     }
   }
 }
@@ -255,6 +392,8 @@ bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSo
     data.broad_previous_candidates.reserve(static_cast<std::size_t>(model.soft.node_count));
     data.candidate_nodes.reserve(static_cast<std::size_t>(model.soft.node_count));
     data.broad_scan_hits.reserve(static_cast<std::size_t>(model.soft.node_count));
+    data.broad_faces_kept.clear();
+    data.broad_faces_kept.reserve(static_cast<std::size_t>(model.soft.face_count));
   }
   data.candidate_nodes.swap(data.broad_previous_candidates);
   data.candidate_nodes.clear();
@@ -262,6 +401,8 @@ bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSo
   data.broad_nodes_scanned = 0;
   data.broad_seed_nodes = 0;
   data.broad_faces_tested = 0;
+  data.broad_faces_transformed = 0;
+  data.broad_faces_kept.clear();
 
   const Query query = make_query(model, frame, data);
   Collector collect(model, frame, soft, query, data);
@@ -277,8 +418,13 @@ bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSo
   data.broad_scan_hits.clear();
   for (int i = 0; i < count; ++i) {
     // Nodes are 256 bytes apart: a software prefetch this far ahead keeps enough misses in flight
-    // (measured on the 10 242-node sphere: 10 ns per node without it, 6 with it).
-    if (i + kScanPrefetchAhead < count) __builtin_prefetch(&soft.m_nodes[i + kScanPrefetchAhead].m_x);
+    // (measured on the 10 242-node sphere: 10 ns per node without it, 6 with it). m_x and m_q
+    // straddle a cache line when the node array sits at 32 mod 64 (m_x at 48 mod 64 on the bench's
+    // 20 480-face sphere): both lines are prefetched.
+    if (i + kScanPrefetchAhead < count) {
+      __builtin_prefetch(&soft.m_nodes[i + kScanPrefetchAhead].m_x);
+      __builtin_prefetch(&soft.m_nodes[i + kScanPrefetchAhead].m_q);
+    }
     const btVector3& x = soft.m_nodes[i].m_x;
     const btVector3& q = soft.m_nodes[i].m_q;
     // Six independent compares and one branch (taken only near the tool).
@@ -289,11 +435,21 @@ bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSo
   data.broad_nodes_scanned = count;
   // Everything the faces around these nodes read is cold after Bullet's step (a few thousand
   // misses on the finest mesh, ~60 µs when taken one after another): it is prefetched in stages,
-  // each stage's misses in flight together, before the faces are tested in the usual order.
+  // each stage's misses in flight together, before the faces are reached in the usual order.
+  // Only the seeds' faces: the scan's union box also takes in nodes between the near and the
+  // memory query (437 hits for 247 seeds on the bench's 20 480-face sphere).
+  std::size_t seeds = 0;
+  for (const int node : data.broad_scan_hits)
+    if (collect.is_seed(node)) data.broad_scan_hits[seeds++] = node;
+  data.broad_scan_hits.resize(seeds);
+  data.broad_seed_nodes = static_cast<int>(seeds);
   prefetch_faces_around(model, soft, data, data.broad_previous_candidates);
   prefetch_faces_around(model, soft, data, data.broad_scan_hits);
-  for (const int node : data.broad_previous_candidates) collect.retest_previous(node);
-  for (const int node : data.broad_scan_hits) collect.seed_if_near(node);
+  for (const int node : data.broad_previous_candidates) collect.reach_faces_around(node);
+  for (const int node : data.broad_scan_hits) collect.reach_faces_around(node);
+  // The exact test, in the order the faces were reached (so candidate_nodes keeps its order).
+  prefetch_kept_faces(model, data);
+  collect.test_kept_faces();
   // A canonical order for the later stages: the node sweep gives a tool node to the FIRST of
   // several triangles it touches at the same moment (a held node: τ = 1 on each), so the
   // traversal order would otherwise decide contacts (clamp scenes: ±25 % peak force between two

@@ -134,10 +134,12 @@ struct CollisionData {
   std::vector<std::int64_t> broad_listed_stamp;      // soft node listed in candidate_nodes at this step
   std::vector<int> broad_previous_candidates;        // last step's candidate nodes (re-tested directly)
   std::vector<int> broad_scan_hits;                  // nodes inside the scan's union box this step
+  std::vector<int> broad_faces_kept;                 // faces the world-bounds pre-filter passed to the exact test
   // What the last call visited (tests and the bench count these instead of timing them).
   int broad_nodes_scanned = 0;        // soft nodes whose start/end positions the scan read (every node)
   int broad_seed_nodes = 0;           // soft nodes whose own start/end box met the query
-  int broad_faces_tested = 0;         // soft faces whose tool-frame swept box was tested
+  int broad_faces_tested = 0;         // soft faces reached and tested (pre-filter on their world bounds)
+  int broad_faces_transformed = 0;    // of those, faces the exact tool-frame test ran on (vertices transformed)
 };
 
 // The step's frame quantities (rotations, translations, velocities, swept tool bounds) from the
