@@ -1,11 +1,9 @@
 // Stage 4 of the paired collision (host_sim/src/thin_body/enforced_displacement.cpp): what a
 // HELD soft node does while the tool holds still — the mechanism behind issue 5's "paired → hold
 // jitter ≤ 1 %".
-//  * With ThinBodyCollisionParams::held_node_friction (an option, off by default): a node held on
-//    a tool face sticks to its tool-frame point unless the soft body drags it along the face
-//    harder than Coulomb friction (μ = the soft body's kDF) allows; beyond that it slides by the
-//    excess. (Without it a held node slides freely, and under a held tool the coarse ball can
-//    creep out sideways and the contact set keeps changing.)
+//  * The tool face is frictionless: a held node dragged along it slides freely, only its normal
+//    position is enforced (a Coulomb-friction option was measured and deleted:
+//    ThinBodyCollisionParams).
 //  * A node lifted off the face moves freely and, pushed back, is held where it lands.
 #include "soft_scene_fixture.hpp"
 
@@ -34,10 +32,8 @@ struct HeldSlab {
 
   HeldSlab() : tool(test_scene::plate_tool(0.004)) {
     world.add_slab(0.1, 10);
-    world.soft().m_cfg.kDF = 0.2f;  // μ between a held node and the tool (the scenes' soft friction)
-    ThinBodyCollisionParams params;
-    params.held_node_friction = true;  // the option under test (off by default)
-    collision = make_paired_collision(tool, world.soft(), params);
+    world.soft().m_cfg.kDF = 0.2f;  // the scenes' soft friction: Bullet's, not applied by the paired response
+    collision = make_paired_collision(tool, world.soft(), ThinBodyCollisionParams{});
     for (int i = 0; i < world.soft().m_nodes.size(); ++i)
       if (to_eigen(world.soft().m_nodes[i].m_x).norm() < 1e-6) centre = i;
     ToolPose previous;
@@ -62,23 +58,20 @@ struct HeldSlab {
   }
 };
 
-TEST(EnforcedDisplacement, HeldNodeSticksWithinTheFrictionConeAndSlidesByTheExcess) {
+TEST(EnforcedDisplacement, HeldNodeDraggedAlongTheFaceSlidesFreely) {
   HeldSlab slab;
   ASSERT_GE(slab.centre, 0);
   const Eigen::Vector3d held = to_eigen(slab.world.soft().m_nodes[slab.centre].m_x);
   ASSERT_NEAR(held.y(), -0.002, 1e-5) << "the centre node is held on the plate's bottom face";
-  // (The bottom face's outward normal is −y: +y pushes the node into the plate.)
-  // Pushed 1 mm into the face and dragged 0.1 mm along it: 0.1 mm ≤ μ·1 mm = 0.2 mm → it stays.
+  // (The bottom face's outward normal is −y: +y pushes the node into the plate.) Pushed 1 mm into
+  // the face and dragged 0.1 mm, then 0.5 mm along it: back on the face, where the drag took it.
   const Eigen::Vector3d after_small = slab.hold_step_with_drag(Eigen::Vector3d(1e-4, 1e-3, 0));
-  EXPECT_NEAR(after_small.x(), held.x(), 1e-7) << "static friction: the held node does not slide";
+  EXPECT_NEAR(after_small.x(), held.x() + 1e-4, 1e-6) << "no friction: the tangential drag stays";
   EXPECT_NEAR(after_small.y(), held.y(), 1e-6) << "back on the face";
-  // Pushed 1 mm and dragged 0.5 mm: slides by 0.5 − 0.2 = 0.3 mm (kinetic friction removes μ·push).
   const Eigen::Vector3d after_large = slab.hold_step_with_drag(Eigen::Vector3d(5e-4, 1e-3, 0));
-  EXPECT_NEAR(after_large.x() - held.x(), 3e-4, 2e-6) << "beyond the cone it slides by the excess";
+  EXPECT_NEAR(after_large.x(), held.x() + 6e-4, 2e-6);
   EXPECT_NEAR(after_large.y(), held.y(), 1e-6);
-  // And from its new held point it sticks again.
-  const Eigen::Vector3d after_again = slab.hold_step_with_drag(Eigen::Vector3d(-1e-4, 1e-3, 0));
-  EXPECT_NEAR(after_again.x(), after_large.x(), 1e-7);
+  EXPECT_GT(slab.result.contacted_triangles, 0);
 }
 
 TEST(EnforcedDisplacement, HeldNodeLiftedOffMovesFreelyAndIsHeldAgainWhereItLands) {

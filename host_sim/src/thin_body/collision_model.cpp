@@ -158,7 +158,6 @@ void allocate_collision_data(const CollisionModel& model, CollisionData& data) {
   data.moved_nodes.reserve(soft_nodes);
   data.hold_stamp.assign(soft_nodes, -1);
   data.hold_plane.assign(soft_nodes, -1);
-  data.hold_tool_m.assign(soft_nodes, Eigen::Vector3d::Zero());
   data.node_share.assign(soft_nodes, 0.0);
   data.candidate_nodes.clear();
   data.candidate_nodes.reserve(soft_nodes);

@@ -50,50 +50,18 @@ struct Writer {
   const StepFrame& frame;
   btSoftBody& soft;
   CollisionData& data;
-  double friction_ratio;  // Coulomb μ between a held soft node and the tool face
   DisplacementCounts counts;
 
   bool fixed(int node) const { return soft.m_nodes[node].m_im == 0; }
 
-  // Whether the node was held on this plane at the end of the last step (paired only: the ray-only
-  // variant has no soft-node side memory).
-  bool held_last_step_on(int node, int plane_index) const {
-    const auto n = static_cast<std::size_t>(node);
-    return model.paired && data.hold_stamp[n] == frame.step - 1 && data.hold_plane[n] == plane_index;
-  }
-
-  // Where a node goes on `plane` (+ skin): straight along the plane's normal. With
-  // ThinBodyCollisionParams::held_node_friction (off by default, see there) a node held on that
-  // plane last step stays where it was held in the tool
-  // frame (it moves with the tool, BRIEF §3 item 4) unless the soft body drags it along the face
-  // harder than Coulomb friction allows: position-based friction (Müller et al. 2007; Macklin et
-  // al. 2014, "Unified particle physics", eq. 24) — in one step the node's tangential slip from
-  // its held point and its push behind the face both come from the same forces × dt²/m, so
-  // |slip| ≤ μ·push is static friction (it stays put), and beyond that it slides by the excess.
-  // Why: with the normal projection alone a held node slid freely along the tool, so under a held
-  // tool the coarse ball kept creeping out sideways from under it (its centre moved up to 28 mm
-  // during a 0.5 s hold), taking nodes off the face and bringing others onto the rims: the held
-  // force changed by 10–40 % without the tool moving. μ is the soft body's own friction
-  // coefficient (btSoftBody::Config::kDF, the scene's soft_body.friction_ratio).
+  // Where a node goes on `plane` (+ skin): straight along the plane's normal (the tool face is
+  // frictionless: a held node slides freely along it; a Coulomb-friction option was measured and
+  // deleted, see ThinBodyCollisionParams).
   Eigen::Vector3d target_on_plane(int node, int plane_index) const {
     const ToolPlane& plane = model.tool.planes()[static_cast<std::size_t>(plane_index)];
     const double target = plane.offset_m + model.params.skin_m;
     const Eigen::Vector3d& end = data.end_tool_m[static_cast<std::size_t>(node)];
-    const Eigen::Vector3d on_plane = end + (target - plane.normal_tool.dot(end)) * plane.normal_tool;
-    if (!model.params.held_node_friction || !held_last_step_on(node, plane_index)) return on_plane;
-    const Eigen::Vector3d& held = data.hold_tool_m[static_cast<std::size_t>(node)];
-    const Eigen::Vector3d held_on_plane = held + (target - plane.normal_tool.dot(held)) * plane.normal_tool;
-    const double push_m = std::max(0.0, target - plane.normal_tool.dot(end));
-    const Eigen::Vector3d slip = on_plane - held_on_plane;
-    const double slip_m = slip.norm();
-    const double static_limit_m = friction_ratio * push_m;
-    const Eigen::Vector3d with_friction =
-        slip_m <= static_limit_m ? held_on_plane : Eigen::Vector3d(held_on_plane + slip * (1.0 - static_limit_m / slip_m));
-    // The friction target lies along the face away from the straight projection: only if the
-    // node's relative path from where it started the step to it stays outside the tool (else the
-    // held point is across an edge the node has gone round, and going there would cross the tool).
-    if (!segment_clears_tool(data.start_tool_m[static_cast<std::size_t>(node)], with_friction)) return on_plane;
-    return with_friction;
+    return end + (target - plane.normal_tool.dot(end)) * plane.normal_tool;
   }
 
   // Moves the node's end position onto `plane` (+ skin) if it is behind it.
@@ -144,7 +112,6 @@ struct Writer {
     }
     data.hold_stamp[n] = frame.step;
     data.hold_plane[n] = plane_index;
-    data.hold_tool_m[n] = data.end_tool_m[n];
   }
 
   bool held_last_step_facing(int node, const Eigen::Vector3d& normal) const {
@@ -267,7 +234,7 @@ struct Writer {
 
 DisplacementCounts enforce_displacement(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft,
                                         CollisionData& data) {
-  Writer writer{model, frame, soft, data, std::max(0.0, static_cast<double>(soft.m_cfg.kDF)), DisplacementCounts{}};
+  Writer writer{model, frame, soft, data, DisplacementCounts{}};
   data.moved_nodes.clear();
   if (model.paired) {
     writer.paired_faces();
@@ -290,73 +257,12 @@ DisplacementCounts enforce_displacement(const CollisionModel& model, const StepF
     const ToolPlane& plane = planes[static_cast<std::size_t>(plane_index)];
     const double gap = plane.normal_tool.dot(data.end_tool_m[n]) - plane.offset_m;
     if (gap > release_m) continue;  // separated: released
-    if (gap < 0.0) {
-      // Held last step and now behind its plane, yet no tool node hit its triangles and its path
-      // did not enter the tool (a node wrapped onto a rim plane beside a thin blade, or held at the
-      // patch's edge between tool nodes): the soft body pushes it INTO the face, so the contact
-      // holds — it goes back onto the face (target_on_plane). Releasing it here dropped a whole
-      // node's force for one step and re-took it the next (bench collision, blade edge-first at
-      // 1 m/s: 29.5 ↔ 14.8 N every few steps, hold jitter 37 %). It is let go if the move would
-      // pass through the tool, from where it is or from where it started the step (the crossing
-      // metric follows that relative path), or if it is behind a large face (not a rim plane) by
-      // half the tool's thickness or more: then it has gone round the rim to the far side, and
-      // putting it back on this face crossed it (with held_node_friction: one node in the 13 m/s
-      // spinning fuzz run and in the convex spatula's 50 m/s plunge).
-      const bool near_this_face = model.rim_plane[static_cast<std::size_t>(plane_index)] != 0 || -gap < 0.5 * model.tool.thickness_m();
-      if (model.params.retake_held_nodes && model.paired && near_this_face) {
-        const Eigen::Vector3d target = writer.target_on_plane(node, plane_index);
-        if (writer.segment_clears_tool(data.end_tool_m[n], target) && writer.segment_clears_tool(data.start_tool_m[n], target))
-          writer.place_on_plane(node, plane_index);
-      }
-      continue;
-    }
+    if (gap < 0.0) continue;  // pushed behind its plane with no tool node hitting it: released
     const double u = release_m > 0.0 ? gap / release_m : 0.0;
     data.node_share[n] = 1.0 - u * u * (3.0 - 2.0 * u);  // smoothstep: flat at the face and at the release
-    data.hold_stamp[n] = frame.step;
-    // Lifted off the face, the node moves freely; if it comes back, it is held where it lands.
-    data.hold_tool_m[n] = data.end_tool_m[n] + (plane.offset_m + model.params.skin_m - plane.normal_tool.dot(data.end_tool_m[n])) * plane.normal_tool;
+    data.hold_stamp[n] = frame.step;  // lifted off the face it moves freely (only its side is remembered)
     data.moved_stamp[n] = frame.step;
     data.moved_nodes.push_back(node);
-  }
-  // Approach band, the mirror of the release ramp above: a free vertex of a triangle around a
-  // colliding node, in front of that node's plane within release_distance, whose rest position
-  // the face has already passed (x_v > 0: the soft body had moved it away from the tool, e.g.
-  // the dent beside a held patch), collides with the same smoothstep share of its gap. Without it
-  // such a node's x_v came in whole the step it touched the face: with held_node_friction the
-  // patch's held nodes no longer spread as the ball flattens, and the hand-speed press gained
-  // 0.59 N (9 % of the 6.7 N peak) in one step as the fourth node touched
-  // (HostSimulation.PressAndReleaseAtHandSpeedKeepTheContactAndAContinuousForce).
-  // Its share now depends on its gap only, on the way in as on the way out. It is not held (no
-  // side memory): it is not on the face. Part of held_node_friction (off by default): without
-  // friction the patch spreads and the hand-speed press steps by 0.10 N at most (bound 0.30 N),
-  // and the band's gap-dependent share makes a ringing ball's force move (bench hold cells:
-  // plate 4 mm at 20 m/s 0.78 % -> 4.7 %, blade at 5 m/s 0.00 % -> 1.45 %).
-  if (model.params.held_node_friction && model.paired && release_m > 0.0) {
-    const std::size_t colliding = data.moved_nodes.size();
-    for (std::size_t k = 0; k < colliding; ++k) {
-      const auto held = static_cast<std::size_t>(data.moved_nodes[k]);
-      const int plane_index = data.hold_plane[held];
-      const ToolPlane& plane = planes[static_cast<std::size_t>(plane_index)];
-      const Eigen::Vector3d normal_world = frame.r_cur * plane.normal_tool;
-      for (int j = model.soft.faces_of_node_begin[held]; j < model.soft.faces_of_node_begin[held + 1]; ++j) {
-        const int face = model.soft.faces_of_node[static_cast<std::size_t>(j)];
-        for (const int node : model.soft.face_nodes[static_cast<std::size_t>(face)]) {
-          const auto n = static_cast<std::size_t>(node);
-          if (data.moved_stamp[n] == frame.step || data.soft_stamp[n] != frame.step || data.hold_stamp[n] == frame.step - 1 ||
-              writer.fixed(node))
-            continue;
-          const double gap = plane.normal_tool.dot(data.end_tool_m[n]) - plane.offset_m;
-          if (gap < 0.0 || gap > release_m) continue;
-          const double x = plane.offset_m + normal_world.dot(frame.t_cur - model.soft.rest_node_world_m[n]);
-          if (x <= 0.0) continue;
-          const double u = gap / release_m;
-          data.node_share[n] = 1.0 - u * u * (3.0 - 2.0 * u);
-          data.hold_plane[n] = plane_index;  // the plane its force pushes along (hold_stamp untouched: not held)
-          data.moved_stamp[n] = frame.step;
-          data.moved_nodes.push_back(node);
-        }
-      }
-    }
   }
   // Paper: "the calculation of x is executed if and only if at least one of the nodes belonging to
   // the triangle is in a colliding state" — the force set is every triangle around a colliding

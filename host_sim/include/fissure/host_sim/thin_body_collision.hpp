@@ -85,39 +85,19 @@ struct ThinBodyCollisionParams {
   // the share's slope small against a held tool's ±40 µm encoder dither (0.2 mm, the former
   // value, put ~7 N/mm of extra stiffness on the coarse ball: force steps of 15 % per dither step).
   double release_distance_m = 2.0e-3;
-  // A node held last step that the soft body pushes behind its plane, with no tool node hitting
-  // its triangles and a path that does not enter the tool (wrapped onto a rim plane beside a thin
-  // blade), is put back on the face instead of released (enforced_displacement.cpp; never a node
-  // whose path from its start would cross the tool, nor one half a thickness or more behind a
-  // large face — it has gone round the rim). Off by default.
-  bool retake_held_nodes = false;
-  // Coulomb friction between a soft node held on a tool face and the face (μ = the soft body's
-  // btSoftBody::Config::kDF, the scene's soft_body.friction_ratio): a held node stays at its
-  // tool-frame point unless the soft body drags it along the face by more than μ × its push into
-  // the face, then it slides by the excess (position-based friction; enforced_displacement.cpp).
-  // With it, neighbours of the held patch within release_distance in front of its face collide
-  // with a share ramping in with their gap (the approach band, the mirror of the release ramp).
-  // Off by default (false: a held node slides freely along the face, only its normal position is
-  // enforced). Not a scene key.
-  //
-  // Both OFF by default because, switched on together, two existing tests still fail
-  // (tests/host_sim, measured 2026-11-22):
-  //  * PairedCollision.EdgeNodesLeaveTheFaceFirstPlungeUnchanged: the 4 mm plate at 50 m/s ends
-  //    with 4 triangles cut by its rim with edge nodes vs 3 without (bound: never more); the 1 mm
-  //    plate at 0.1 m/s holds 12.19 N with edge nodes vs 12.49 N without, where the test expects
-  //    more (its premise: without edge nodes the ball slides away — friction stops that);
-  //  * PaperSceneProxy.ProxyHeldOverAHundredHertzPeriod…/convex_spatula_sphere: 4.56 % RMS of the
-  //    peak (bound 2 %), clamp_vessel 2.01 % (that one fails at 2.19 % with both off too, in the
-  //    working tree of this date).
-  // Fixed on the way (were blockers): the hand-speed press/release step (0.59 N on a 6.7 N peak,
-  // bound 5 %; now 0.23 N, the approach band), one crossed node in the 13 m/s spin fuzz run and in
-  // the convex spatula's 50 m/s plunge (re-take path / depth conditions), the fixture sphere's
-  // 1 m/s hold (PairedCollision.HoldGivesASteadyUpwardForce). Hold jitter on bench collision's
-  // 32 paired hold cells (tests/host_sim/hold_jitter_test.cpp): 13 cells ≤ 1 % with both off,
-  // 16 with both on; what is left is mostly the 128-face ball squirting out sideways from under
-  // the tool (its centre moves 40+ mm; blade / plate 1 mm / convex at 0.1 m/s) or ringing after
-  // an impact, not contact-set chatter.
-  bool held_node_friction = false;
+  // Two off-by-default held-node options of earlier sessions were measured on bench collision's 32
+  // paired hold cells (tests/host_sim/hold_jitter_test.cpp) and on the tests, then deleted:
+  //  * retake_held_nodes — a held node pushed behind its plane (no tool node hitting it, its path
+  //    clear of the tool) put back on the face instead of released. On any plane within half a
+  //    thickness it changed clamp-sphere's squeeze (100 Hz proxy error 0.42 % -> 3.3 % of the
+  //    peak); restricted to rim planes it still leaves triangles sliced by a face-first plate's
+  //    rim (1 mm plate at 10 m/s with edge nodes: 3 at the end of the hold, 0 without);
+  //  * held_node_friction — Coulomb friction between a held node and the face (μ = kDF,
+  //    position-based) with an approach band made a slow press move the ball MORE (plate 1 mm
+  //    at 0.1 m/s: centre 13 mm aside at the end of the plunge vs 6 mm without, then squeezed
+  //    out from under the plate, force -> 0: hold jitter 2.9 % -> 146 %; blade 0.1 m/s 12 % ->
+  //    261 %) and the clamp-vessel proxy error went 1.27 % -> 6.0 % (bound 2 %).
+  // A held node behind its plane is released; the tool face is frictionless.
   // ẋ is a finite difference of x filtered by a first-order low-pass with this cut-off
   // (time constant 1/(2π·fc), i.e. ≈1.6 ms lag at 100 Hz).
   double velocity_filter_cutoff_hz = 100.0;
