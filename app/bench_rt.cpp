@@ -500,6 +500,15 @@ WallRun run_wall(double rate_hz, double stiffness, bool passivity_on) {
   return run;
 }
 
+/// What ended a Z-width column: the criteria the first failing grid point missed.
+std::string failure_text(const WallRun& run) {
+  std::string text;
+  if (!run.stable) text += "unstable";
+  if (!run.passive) text += text.empty() ? "active" : "+active";
+  if (!run.renders) text += text.empty() ? "held back" : "+held back";
+  return text.empty() ? "grid top" : text;
+}
+
 /// Largest K on the grid before the first unstable, active or held-back one.
 double zwidth_k(double rate_hz, bool passivity_on, WallRun& first_failure) {
   double last_good = 0.0;
@@ -651,7 +660,8 @@ void run(const Arguments& args) {
   // 3. Z-width
   std::printf("\n3. Z-width (lockstep): largest stable and passive wall stiffness vs Colgate–Schenkel K < 2b/T, b = %.1f N·s/m\n",
               falcon::kSimViscousDamping_n_s_per_m);
-  std::printf("   %-8s %14s %16s %16s %10s\n", "rate", "bound 2b/T", "K max (PC off)", "K max (PC on)", "off/bound");
+  std::printf("   %-8s %14s %16s %16s %10s   %s\n", "rate", "bound 2b/T", "K max (PC off)", "K max (PC on)", "off/bound",
+              "next K fails: off | on");
   nlohmann::json zwidth = nlohmann::json::array();
   for (const double rate : {500.0, 1000.0, 2000.0, 4000.0, 8000.0}) {
     const double b = falcon::kSimViscousDamping_n_s_per_m;
@@ -659,7 +669,8 @@ void run(const Arguments& args) {
     WallRun failure_off, failure_on;
     const double k_off = zwidth_k(rate, false, failure_off);
     const double k_on = zwidth_k(rate, true, failure_on);
-    std::printf("   %-8.0f %14.0f %16.0f %16.0f %10.2f\n", rate, bound, k_off, k_on, k_off / bound);
+    std::printf("   %-8.0f %14.0f %16.0f %16.0f %10.2f   %s | %s\n", rate, bound, k_off, k_on, k_off / bound,
+                failure_text(failure_off).c_str(), failure_text(failure_on).c_str());
     zwidth.push_back({{"rate_hz", rate},
                       {"period_s", 1.0 / rate},
                       {"device_damping_n_s_per_m", b},
