@@ -3,6 +3,8 @@
 // contact, deterministic, F ∝ dⁿ on a flat slab with area weighting, no allocation per step.
 #include "soft_scene_fixture.hpp"
 
+#include <fissure/host_sim/host_simulation.hpp>
+#include <fissure/host_sim/scene_loader.hpp>
 #include <fissure/host_sim/thin_body_collision.hpp>
 
 #include <gtest/gtest.h>
@@ -660,6 +662,46 @@ TEST(PairedCollision, PoseMatchedRestFrameFollowsTheBodyAndTheWorldFrameDoesNot)
   EXPECT_NEAR(pose_lifted / pose_flat, 1.0, 1e-3);
   EXPECT_NEAR(world_flat / pose_flat, 1.0, 1e-3) << "at rest both frames agree";
   EXPECT_LT(world_lifted, 0.5 * world_flat) << "world rest positions read the lift as 5 mm less indentation";
+}
+
+// Hunt-Crossley's ẋ in the paper's scenes, whose tools only translate (and the clamp's jaws slide along
+// the grip axis): each record's x is offset + n·(t − rest) along its triangle's plane, so its ẋ
+// can never be faster than the part moves, |Δp|/dt + |Δgap|/(2·dt). A triangle whose force plane
+// changes from one step to the next (its first colliding corner found now held on another plane,
+// round a rim) gave ẋ = Δx/dt across the switch before (hunt_crossley_force.cpp): in
+// clamp-sphere ~0.4 m/s of filtered ẋ on a jaw moving at cm/s.
+TEST(PairedCollision, NoRecordIndentsFasterThanItsPartMoves) {
+  for (const char* name : {"spatula-sphere", "convex-spatula-sphere", "clamp-sphere", "clamp-vessel"}) {
+    const SceneDescription scene = load_scene(resolve_scene_path(name));
+    HostSimulation sim(scene, SceneCollisionMethod::kPaired);
+    sim.settle(0.2);
+    const double dt = scene.simulation.time_step_s;
+    const int steps = static_cast<int>(std::floor(trajectory_duration_s(scene) / dt + 1e-9));
+    TrajectorySample previous = sample_trajectory(scene, 0.0);
+    double worst_ratio = 0.0, worst_rate_m_s = 0.0, worst_bound_m_s = 0.0;
+    int records = 0;
+    for (int i = 1; i <= steps; ++i) {
+      const TrajectorySample target = sample_trajectory(scene, i * dt);
+      const HostStepResult& r = sim.step(to_tool_pose(target.pose), target.jaw_gap_m);
+      const Eigen::Vector3d dp(target.pose.position_world_m[0] - previous.pose.position_world_m[0],
+                               target.pose.position_world_m[1] - previous.pose.position_world_m[1],
+                               target.pose.position_world_m[2] - previous.pose.position_world_m[2]);
+      // The filter is a low-pass of the per-step rates, so the speed bound of the last few steps.
+      const double bound_m_s = dp.norm() / dt + 0.5 * std::abs(target.jaw_gap_m - previous.jaw_gap_m) / dt;
+      worst_bound_m_s = std::max(worst_bound_m_s, bound_m_s);
+      for (int p = 0; p < r.part_count; ++p)
+        for (const ContactRecord& c : r.part_results[static_cast<std::size_t>(p)].contacts) {
+          ++records;
+          worst_rate_m_s = std::max(worst_rate_m_s, std::abs(c.penetration_rate_m_s));
+        }
+      previous = target;
+    }
+    worst_ratio = worst_rate_m_s / std::max(worst_bound_m_s, 1e-12);
+    std::printf("[hc rate] %-22s %6d records: max |xdot| %.4f m/s, fastest part %.4f m/s\n", name, records, worst_rate_m_s,
+                worst_bound_m_s);
+    EXPECT_GT(records, 0) << name;
+    EXPECT_LE(worst_ratio, 1.0 + 1e-6) << name << ": a record indented faster than its part moved";
+  }
 }
 
 }  // namespace

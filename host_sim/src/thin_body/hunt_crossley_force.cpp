@@ -47,6 +47,11 @@ namespace {
 
 Eigen::Vector3d to_eigen(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
 
+// Last step's x of a corner and this plane's x at the previous pose agree to rounding when the
+// triangle stayed on one plane (both are offset + n·(t − rest) in double); a larger gap is a
+// change of the triangle's force plane (1 nm: far below any real indentation step).
+constexpr double kPlaneSwitchTolerance_m = 1.0e-9;
+
 Eigen::Vector3d centroid(const SoftSurfaceModel& surface, const btSoftBody& soft, int face, bool start_of_step) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (const int node : surface.face_nodes[static_cast<std::size_t>(face)])
@@ -117,6 +122,15 @@ void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, co
         const double x = std::max(0.0, plane.offset_m + normal_world.dot(frame.t_cur - rest));
         const double x_start = std::max(0.0, plane.offset_m + normal_prev_world.dot(frame.t_prev - rest));
         const std::size_t slot = 3 * f + corner;
+        // In the world rest frame x is a function of the tool pose and of the plane only, so this
+        // plane's x at the previous pose (x_start) is last step's x — unless the triangle's force
+        // plane changed (its first colliding corner is now held on another plane, e.g. round a
+        // rim): then last step's x was taken along another normal, and differencing across the
+        // switch turned a change of plane into an indentation rate (mm per ms is m/s, × λ). The
+        // filter restarts from x_start at a switch, as at first contact.
+        if (!pose_frame && data.hc_corner_stamp[slot] == frame.step - 1 &&
+            std::abs(data.hc_corner_x_prev_m[slot] - x_start) > kPlaneSwitchTolerance_m)
+          data.hc_corner_stamp[slot] = -1;
         const double rate = filtered_rate(data.hc_corner_stamp[slot], data.hc_corner_x_prev_m[slot],
                                           data.hc_corner_rate_filtered_m_s[slot], frame.step, x, x_start, frame.dt_s, alpha);
         const double x_pow_n = std::pow(x, hc.n);
