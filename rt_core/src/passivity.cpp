@@ -29,16 +29,6 @@ double forgiven_j(const PassivityState& state, double margin_j) noexcept {
   return std::min(owed_j, std::max(0.0, state.energy_j + margin_j));
 }
 
-/// Credits the mechanism's damping b_c·|v_f|²·T to g's account, as far as the bounded reserve
-/// allows (passivity.hpp: E_c = E − C stays above −kPassivityCreditReserveMargins margins).
-void credit_device_damping(const PassivityConfig& config, PassivityState& state, const Eigen::Vector3d& v_filtered_m_per_s,
-                           double period_s) noexcept {
-  const double reserve_j = kPassivityCreditReserveMargins * config.margin_j;
-  const double room_j = std::max(0.0, state.energy_j - state.damping_credit_j + reserve_j);
-  const double dissipated_j = config.device_damping_credit_n_s_per_m * v_filtered_m_per_s.squaredNorm() * period_s;
-  state.damping_credit_j += std::min(room_j, dissipated_j);
-}
-
 /// Raw speed from which the energy bound acts (passivity.hpp).
 double bounding_speed_m_per_s(double period_s) noexcept {
   return std::max(kPassivityBoundingMinSpeed_m_per_s,
@@ -73,7 +63,6 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
   }
   // Forgiven work already dissipated is no longer owed (see forgiven_j).
   state.recovery_forgiven_j = std::min(state.recovery_forgiven_j, std::max(0.0, state.energy_j + config.margin_j));
-  credit_device_damping(config, state, v_filtered_m_per_s, period_s);
   if (!config.enabled) {
     state.reduction_fraction = 0.0;
     state.reduction_n = 0.0;
@@ -97,16 +86,11 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
     // so its noise cannot reach the force as a step.)
     const Eigen::Vector3d total = state.force_sent_last_device_n + force;
     // The damper acts on all of E; the reduction g on E less the forgiven recovery work
-    // (kPassivityRecoveryForgiveness_j per fault: a force brought back at a static hold) and
-    // less the mechanism's damping credit C — the credit never below E less the plain
-    // observer's ceiling (passivity.hpp: whatever b really is, E stays bounded), and never
-    // cutting into the forgiven recovery work (min: with no credit this is the owed energy).
+    // (kPassivityRecoveryForgiveness_j per fault: a force brought back at a static hold).
     const double predicted_all_j =
         state.energy_j + std::max(total.dot(v_filtered_m_per_s), total.dot(v_raw_m_per_s)) * period_s;
     const double excess_all_j = predicted_all_j + config.margin_j;
-    const double ceiling_j = kPassivityObserverCeilingMargins * config.margin_j;
-    const double owed_j = predicted_all_j - forgiven_j(state, config.margin_j);
-    const double predicted_j = std::max(owed_j - state.damping_credit_j, std::min(owed_j, predicted_all_j - ceiling_j));
+    const double predicted_j = predicted_all_j - forgiven_j(state, config.margin_j);
     const double excess_j = predicted_j + config.margin_j;  // above the reference −margin
 
     // g: while the environment returns energy (F̂·v > 0 by the raw difference, which has no

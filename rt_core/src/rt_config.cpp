@@ -40,9 +40,6 @@ const char* check_config(const RtConfig& c) noexcept {
   if (!positive(c.passivity.max_correction_step_n)) return "passivity.max_correction_step_n must be > 0";
   if (!positive(c.passivity.dissipation_time_s)) return "passivity.dissipation_time_s must be > 0";
   if (!non_negative(c.passivity.damping_ramp_s)) return "passivity.damping_ramp_s must be ≥ 0";
-  if (!non_negative(c.passivity.device_damping_credit_n_s_per_m)) {
-    return "passivity.device_damping_credit_n_s_per_m must be ≥ 0";
-  }
   if (!(positive(c.safety.max_force_n) && c.safety.max_force_n <= kFalconMaxForce_n)) {
     return "safety.max_force_n must be in (0, 8] N (the Falcon's rating)";
   }

@@ -319,11 +319,9 @@ TEST(RtLoop, SimFalconFaultsEndInZeroForceAndRecover) {
   for (int k = 2000; k < 2003; ++k) EXPECT_EQ(force[k], 0.0) << k;
   EXPECT_NE(faults[2500] & kFaultEncoderJump, 0u);
   EXPECT_EQ(force[2500], 0.0);
-  // The force is back before each next fault: the wall holds this hand at ~1.0-1.2 N, moving by
-  // a few % from tick to tick (1.0 N, the former bound, sat inside that spread).
-  EXPECT_GT(force[1499], 0.8);
-  EXPECT_GT(force[1999], 0.8);
-  EXPECT_GT(force[2499], 0.8);
+  EXPECT_GT(force[1499], 1.0);
+  EXPECT_GT(force[1999], 1.0);
+  EXPECT_GT(force[2499], 1.0);
   // The jumped counts persist (lost counts), so the device now reads a shifted position and
   // the force there is whatever the wall gives; what matters is that the fault cleared.
   for (int k = 2500; k < 2500 + RtConfig{}.faults.recovery_ticks; ++k) EXPECT_EQ(force[k], 0.0) << k;

@@ -66,44 +66,6 @@
 // speed no hand holding still reaches; safety's rate limit (4 N per tick) still applies.
 // What it cannot bound is the work of the command already sent (and of the one whose motion
 // was just observed): at 1.7 m/s and 6 N that is ≈ 10 mJ per tick (hand_teleports).
-//
-// The device's own damping pays for what the sampled, delayed loop generates (session 6).
-// Until then the reduction g acted on the plain observer E, which counts the energy a
-// delayed, sampled wall generates at an impact but not what the mechanism's damper b
-// dissipates meanwhile — the very damper that makes the wall stable (Colgate & Schenkel 1997:
-// b > K·T/2 + |B|). A stiff wall stores little (½·F²/K: 0.46 mJ for 2.3 N at 5.7 kN/m), so one
-// impact put E above its reference for good; g went to 1 while the wall rang, and a hand at
-// rest does no work that could bring E back, so the wall stayed at ≈ 0 N (fissure bench rt,
-// 1 kHz, K = 1192 N/m: E = +1.55 mJ, g = 1, 0 N held against the expected 1.92 N, while the
-// port including b had absorbed 10.4 mJ). With the controller on, the Z-width was lower than
-// without it at 2–8 kHz. The remedy is Kim & Ryu's energy-bounding premise (J.-P. Kim and
-// J. Ryu, "Energy bounding algorithm based on passivity theorem for stable haptic interaction
-// control", HAPTICS 2004; IJRR 29(6), 2010): energy the loop generates is acceptable up to what
-// the device's physical damping dissipates. g (and only g) acts on the account
-//     E_c = E − C,   C = Σ b_c·|v_f|²·T        (b_c = device_damping_credit_n_s_per_m)
-// — the observer of the port hand ↔ (mechanism damper + virtual environment), the port whose
-// passivity Colgate & Schenkel's bound is about. Four choices keep it honest:
-//   * b_c below the mechanism's damping (2 of SimFalcon's nominal 3 N·s/m; the Falcon's is "a
-//     few N·s/m", not measured on a unit): EBA needs b_c ≤ b, and the rest is margin.
-//   * C is taken on the filtered velocity, not EBA's b·Δp²/T of the raw encoder difference: at
-//     a hold the raw difference toggles by one count (b·count²/T = 5 µJ per toggle at 1 kHz, 40 µJ
-//     at 8 kHz with b_c = 2 N·s/m, all of it quantisation, not motion); the filter's zeros at
-//     Nyquist remove that toggle, and its attenuation near 100 Hz only makes C smaller.
-//   * C only accrues while E_c is above −kPassivityCreditReserveMargins margins (1.2 mJ: a bounded
-//     reserve, like a bounded observer window: hours of free motion must not bank joules that
-//     later hide a truly active contact; Hannaford & Ryu 2002 note the same masking by a large
-//     negative PO).
-//   * The plain observer keeps a ceiling: g also acts whenever E itself is above
-//     kPassivityObserverCeilingMargins margins (2 mJ). Whatever b really is, what the device
-//     can put into the hand (what the stress harness bounds at 25 mJ) stays bounded: a wall
-//     beyond even the widened Z-width rings until E reaches the ceiling and is then held back
-//     as before. The damper β and the energy bound at speed keep acting on the plain E.
-// The credit does not touch the static force: at rest v_f = 0, C does not move, and g only
-// changes if E_c says so — it is g that no longer engages for a wall the mechanism's damper
-// keeps passive. A wall that does hold g up (E_c above the reference) still holds it at rest;
-// no give-back at rest was added (measured: no change to any Z-width figure with b_c > 0, none
-// at all without the credit — E_c stays above the reference, so giving back has no energy
-// to pay with).
 #include <cstdint>
 
 #include <Eigen/Core>
@@ -153,30 +115,6 @@ inline constexpr double kDefaultPassivityDissipationTime_s = 0.05;
 /// of a 3000 N/m wall on the Falcon's ~0.15 kg (≈ 22 Hz), far longer than a tick.
 inline constexpr double kDefaultPassivityDampingRamp_s = 0.02;
 
-/// Physical damping credited to the reduction's account [N·s/m] (energy bounding, Kim & Ryu
-/// 2004): two thirds of SimFalcon's nominal mechanism damping kSimViscousDamping_n_s_per_m
-/// (3 N·s/m, "a few N·s/m" for the Falcon, not measured on a unit). EBA is passive for any
-/// b_c ≤ b; the third left over is margin for a unit with less damping than the nominal.
-inline constexpr double kDefaultPassivityDeviceDampingCredit_n_s_per_m = 2.0;
-/// Largest reserve the damping credit may build below E [margins] (1.2 mJ): about one
-/// stiff-wall impact at 0.1 m/s (½·0.15 kg·(0.1 m/s)² = 0.75 mJ, plus the ringing), so that an
-/// impact is paid for by the damping of the motion before it, but free motion cannot bank a
-/// reserve that hides an active contact. Measured (fissure stress --profile full --case
-/// hand_teleports, seed 7): 10 margins (4 mJ) let that case reach 30.4 mJ (fail, bound 25 mJ);
-/// 3 margins 16.6 mJ (21.0 mJ without the credit), and the stiff wall of
-/// PassivityClosedLoop.AStiffWallIsStillRenderedAfterItsImpactRings is still rendered.
-inline constexpr double kPassivityCreditReserveMargins = 3.0;
-/// Ceiling of the plain observer E [margins] (2 mJ): above it g acts whatever the credit
-/// says (the credit is taken off the owed energy at most down to E − ceiling; a fault's forgiven
-/// recovery work is never cut by it). What the credit lets E stand at before a fast event adds
-/// to what the energy bound at speed cannot stop (the two commands already on their way: 10–20
-/// mJ when a hand is teleported out of a contact under 6–8 N), and the stress harness bounds the
-/// sum at 25 mJ. An earlier try measured (hand_teleports, credit off/on): an 8 mJ ceiling 15.6 ->
-/// 19.5 / 24.3 mJ, 4 mJ 26.0 mJ (fail); 1 mJ (2 margins) kept the 8 kHz Z-width below the
-/// controller-off one (8882 < 11102 N/m). Measured here: 2 margins (0.8 mJ) holds the wall of
-/// AStiffWallIsStillRenderedAfterItsImpactRings back again; 5 margins renders it.
-inline constexpr double kPassivityObserverCeilingMargins = 5.0;
-
 /// After a device fault [s]: the work done while safety brings the force back (its
 /// kDefaultFaultRampIn_s = 0.25 s ramp-in, after FaultConfig's 20 clean ticks ≤ 40 ms at
 /// 500 Hz) is counted in E and also reported as recovery_energy_j (the ramp pushes a hand
@@ -219,16 +157,11 @@ struct PassivityConfig {
   double max_force_n = kFalconMaxForce_n;
   /// Energy bounding at speed (see above); off only to measure what it does.
   bool energy_bounding = true;
-  /// Mechanism damping credited to the reduction's account (see above) [N·s/m]; must not
-  /// exceed the device's real damping. 0: g acts on the plain observer E (before session 6).
-  double device_damping_credit_n_s_per_m = kDefaultPassivityDeviceDampingCredit_n_s_per_m;
 };
 
 struct PassivityState {
   double energy_j = 0.0;  ///< observer: Σ F·Δp since start (positive = active)
   double dissipated_by_controller_j = 0.0;   ///< Σ −correction·v_f·T (what the controller took out)
-  /// C: Σ b_c·|v_f|²·T credited to g's account E_c = E − C (only while E_c > −reserve).
-  double damping_credit_j = 0.0;
   Eigen::Vector3d force_sent_last_device_n = Eigen::Vector3d::Zero();   ///< computed tick k−1
   Eigen::Vector3d force_acting_device_n = Eigen::Vector3d::Zero();      ///< computed tick k−2 (acting now)
   Eigen::Vector3d p_prev_device_m = Eigen::Vector3d::Zero();
