@@ -91,31 +91,20 @@ PlungeHoldResult run_plunge_hold(const SceneDescription& scene, SceneCollisionMe
     result.max_penetration_m = std::max(result.max_penetration_m, r.crossing.max_penetration_m);
     result.step_s.push_back(r.times.total_s);
   };
-  auto ball_centre = [&sim]() {
+  // Only for the hold window's steps (hold_trace): the plunge's steps are not traced.
+  auto trace = [&sim](const HostStepResult& r) {
+    HoldStepTrace t;
+    for (int p = 0; p < r.part_count; ++p) t.contacted_triangles += r.part_results[static_cast<std::size_t>(p)].contacted_triangles;
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     for (const Eigen::Vector3d& p : sim.node_positions_world_m()) sum += p;
     sum /= static_cast<double>(std::max<std::size_t>(1, sim.node_positions_world_m().size()));
-    return Vec3{sum.x(), sum.y(), sum.z()};
-  };
-  auto trace = [&](const HostStepResult& r) {
-    HoldStepTrace t;
-    t.force_n = r.force_on_tool_world_n.norm();
-    for (int p = 0; p < r.part_count; ++p) {
-      const CollisionStepResult& part = r.part_results[static_cast<std::size_t>(p)];
-      t.contacted_triangles += part.contacted_triangles;
-      t.displaced_soft_nodes += part.displaced_soft_nodes;
-      t.colliding_tool_nodes += part.colliding_tool_nodes;
-    }
-    t.ball_centre_world_m = ball_centre();
+    t.ball_centre_world_m = Vec3{sum.x(), sum.y(), sum.z()};
     return t;
   };
   while (pose.position_world_m.y() > end_y) {
     pose.position_world_m.y() = std::max(end_y, pose.position_world_m.y() - speed_m_s * dt);
-    const HostStepResult& r = sim.step(pose);
-    record(r);
-    result.plunge_trace.push_back(trace(r));
+    record(sim.step(pose));
   }
-  result.ball_centre_at_plunge_end_world_m = ball_centre();
   const long settle_steps = std::lround(kHoldSettle_s / dt);
   const long hold_steps = std::lround(hold_s / dt);
   result.hold_force_n.reserve(static_cast<std::size_t>(hold_steps));
@@ -123,10 +112,7 @@ PlungeHoldResult run_plunge_hold(const SceneDescription& scene, SceneCollisionMe
   for (long i = 0; i < settle_steps + hold_steps; ++i) {
     const HostStepResult& r = sim.step(pose);
     record(r);
-    if (i < settle_steps) {
-      result.plunge_trace.push_back(trace(r));
-      continue;
-    }
+    if (i < settle_steps) continue;
     result.hold_force_n.push_back(r.force_on_tool_world_n.norm());
     result.hold_trace.push_back(trace(r));
   }

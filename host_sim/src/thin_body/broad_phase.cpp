@@ -392,7 +392,6 @@ bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSo
     data.broad_previous_candidates.reserve(static_cast<std::size_t>(model.soft.node_count));
     data.candidate_nodes.reserve(static_cast<std::size_t>(model.soft.node_count));
     data.broad_scan_hits.reserve(static_cast<std::size_t>(model.soft.node_count));
-    data.broad_faces_kept.clear();
     data.broad_faces_kept.reserve(static_cast<std::size_t>(model.soft.face_count));
   }
   data.candidate_nodes.swap(data.broad_previous_candidates);

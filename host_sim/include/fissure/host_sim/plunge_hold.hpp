@@ -62,13 +62,10 @@ struct HoldForceStats {
 };
 [[nodiscard]] HoldForceStats hold_force_stats(const std::vector<double>& force_n);
 
-/// One step of the measured hold window: what the diagnosis of a jittery cell needs (is the
-/// contact set chattering, or is the ball moving?).
+/// One step of the measured hold window, beside its force (hold_force_n): what the diagnosis of
+/// a jittery cell needs (is the contact set chattering, or is the ball moving?).
 struct HoldStepTrace {
-  double force_n = 0.0;             ///< |F| on the tool
   int contacted_triangles = 0;      ///< triangles in the force set (paired/ray; 0 for bullet)
-  int displaced_soft_nodes = 0;     ///< soft nodes written by the enforced displacement this step
-  int colliding_tool_nodes = 0;     ///< tool nodes in contact after the exclusion
   Vec3 ball_centre_world_m{};       ///< mean of the soft nodes
 };
 
@@ -77,8 +74,6 @@ struct PlungeHoldResult {
   double max_penetration_m = 0.0;
   std::vector<double> hold_force_n;  ///< |F| per step of the measured hold window
   std::vector<HoldStepTrace> hold_trace;  ///< per step of the measured hold window
-  std::vector<HoldStepTrace> plunge_trace;  ///< per step of the plunge and of the hold's settle window
-  Vec3 ball_centre_at_plunge_end_world_m{};  ///< mean of the soft nodes when the tool stopped
   std::vector<double> step_s;        ///< wall time of every step (plunge and hold)
   HoldForceStats hold;
 };
