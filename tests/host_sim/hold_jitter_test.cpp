@@ -20,13 +20,6 @@ constexpr double kMaxPenetrationM = 1.0e-4;
 constexpr double kHoldS = 0.5;
 const double kSpeedsMS[] = {0.1, 0.5, 1, 2, 5, 10, 20, 50};
 
-int contact_set_changes(const PlungeHoldResult& c) {
-  int changes = 0;
-  for (std::size_t i = 1; i < c.hold_trace.size(); ++i)
-    changes += c.hold_trace[i].contacted_triangles != c.hold_trace[i - 1].contacted_triangles ? 1 : 0;
-  return changes;
-}
-
 class PairedSweepHold : public ::testing::TestWithParam<int> {};
 
 // The mandatory invariants in every cell: no crossed node, penetration ≤ 0.1 mm, and the held
@@ -37,7 +30,9 @@ TEST_P(PairedSweepHold, NoCrossingNoPenetrationAndContactAtEverySpeed) {
   for (const double speed : kSpeedsMS) {
     const PlungeHoldResult c = run_plunge_hold(scene, SceneCollisionMethod::kPaired, speed, tool.leading_half_m, kHoldS);
     // The diagnosis beside the figure: does the contact set change, and does the ball move?
-    const int set_changes = contact_set_changes(c);
+    int set_changes = 0;
+    for (std::size_t i = 1; i < c.hold_trace.size(); ++i)
+      set_changes += c.hold_trace[i].contacted_triangles != c.hold_trace[i - 1].contacted_triangles ? 1 : 0;
     const Vec3& a = c.hold_trace.front().ball_centre_world_m;
     const Vec3& b = c.hold_trace.back().ball_centre_world_m;
     std::printf("%-17s %5.1f m/s: crossed %d, penetration %.4f mm, F_hold %.3f N, jitter %.3f %% | contact-set changes %d, "
@@ -50,24 +45,8 @@ TEST_P(PairedSweepHold, NoCrossingNoPenetrationAndContactAtEverySpeed) {
   }
 }
 
-// An edge-first blade held 20 mm into the ball keeps its contact set: the vertices its rim wrapped
-// are taken back onto the rim when their springs lift them up beside the blade, instead of being
-// released and re-wrapped a step later (enforced_displacement.cpp). Before that retake the
-// contact set changed on 311–364 of the 500 hold steps at 0.5–2 m/s and the force jittered by
-// 37 %; now 0–2 changes.
-TEST(PairedSweepHoldBlade, EdgeFirstBladeHeldInTheBallKeepsItsContactSet) {
-  const PlungeTool& tool = plunge_tools()[2];
-  ASSERT_EQ(std::string(tool.name), "blade_edge_first");
-  const SceneDescription scene = plunge_scene(tool);
-  for (const double speed : {0.5, 1.0, 2.0}) {
-    const PlungeHoldResult c = run_plunge_hold(scene, SceneCollisionMethod::kPaired, speed, tool.leading_half_m, kHoldS);
-    EXPECT_LE(contact_set_changes(c), 2) << speed << " m/s";
-    EXPECT_GT(c.hold.mean_n, 0.0) << speed << " m/s";
-  }
-}
-
 // The hold-jitter target, ≤ 1 % in every cell. NOT MET (disabled so that it stays
-// visible; run with --gtest_also_run_disabled_tests): 14 of the 32 cells are within 1 %; the
+// visible; run with --gtest_also_run_disabled_tests): 13 of the 32 cells are within 1 %; the
 // diagnosis beside each cell (contact-set changes, ball centre motion over the hold) is printed
 // by the test above.
 TEST_P(PairedSweepHold, DISABLED_HoldJitterIsAtMostOnePercentAtEverySpeed) {

@@ -158,7 +158,6 @@ void allocate_collision_data(const CollisionModel& model, CollisionData& data) {
   data.moved_nodes.reserve(soft_nodes);
   data.hold_stamp.assign(soft_nodes, -1);
   data.hold_plane.assign(soft_nodes, -1);
-  data.hold_wrapped.assign(soft_nodes, 0);
   data.node_share.assign(soft_nodes, 0.0);
   data.candidate_nodes.clear();
   data.candidate_nodes.reserve(soft_nodes);

@@ -104,7 +104,6 @@ struct CollisionData {
   std::vector<int> moved_nodes;            // ... listed (their triangles have a colliding node)
   std::vector<std::int64_t> hold_stamp;    // soft-node side memory: held on a tool plane ...
   std::vector<int> hold_plane;             // ... this one, at step hold_stamp
-  std::vector<std::uint8_t> hold_wrapped;  // ... and it got there wrapped round a leading rim (1), not from the plane's front (0)
   std::vector<double> node_share;          // colliding node's share of its force (valid where moved_stamp == step):
                                            // 1 on the face, ramping to 0 over release_distance in front of it
   std::vector<int> candidate_nodes;

@@ -19,9 +19,7 @@
 //     This covers the tool's area between nodes and its rim.
 // Colliding soft nodes = nodes moved this step, plus nodes held last step that are still within
 // release_distance in front of their plane (hysteresis against contact-set chatter; their force
-// share ramps smoothly from 1 on the face to 0 at release_distance, CollisionData::node_share). A
-// node wrapped round a rim that points into the body (an edge-first blade's edge) and lifted back
-// behind the rim by its springs is taken back onto the rim rather than released. Every
+// share ramps smoothly from 1 on the face to 0 at release_distance, CollisionData::node_share). Every
 // triangle around a colliding node is in the force set (paper: "at least one of the nodes
 // belonging to the triangle is in a colliding state"), pushing along its node's plane.
 // ray (the paper's Fig. 3 right): every tool node in contact, excluded or not, puts its triangle's
@@ -66,15 +64,14 @@ struct Writer {
     return end + (target - plane.normal_tool.dot(end)) * plane.normal_tool;
   }
 
-  // Moves the node's end position onto `plane` (+ skin) if it is behind it. `wrapped`: it is
-  // pulled there round a leading rim (from behind the rim plane), see write().
-  bool place_on_plane(int node, int plane_index, bool wrapped = false) {
+  // Moves the node's end position onto `plane` (+ skin) if it is behind it.
+  bool place_on_plane(int node, int plane_index) {
     const ToolPlane& plane = model.tool.planes()[static_cast<std::size_t>(plane_index)];
     Eigen::Vector3d& p = data.end_tool_m[static_cast<std::size_t>(node)];
     const double target = plane.offset_m + model.params.skin_m;
     if (plane.normal_tool.dot(p) >= target) return false;
     p = target_on_plane(node, plane_index);
-    write(node, plane_index, wrapped);
+    write(node, plane_index);
     return true;
   }
 
@@ -98,12 +95,8 @@ struct Writer {
     return false;
   }
 
-  // A node stays "wrapped" while it is held on the rim plane it was wrapped onto (the flag is
-  // what lets the hysteresis below take it back when the soft solver lifts it behind the rim).
-  void write(int node, int plane_index, bool wrapped) {
+  void write(int node, int plane_index) {
     const auto n = static_cast<std::size_t>(node);
-    const bool still_wrapped =
-        data.hold_stamp[n] >= frame.step - 1 && data.hold_plane[n] == plane_index && data.hold_wrapped[n] != 0;
     const Eigen::Vector3d p_world = frame.r_cur * data.end_tool_m[n] + frame.t_cur;
     const Eigen::Vector3d v_world = frame.velocity_world_m_s + frame.angular_velocity_world.cross(p_world - frame.t_cur);
     btSoftBody::Node& soft_node = soft.m_nodes[node];
@@ -119,7 +112,6 @@ struct Writer {
     }
     data.hold_stamp[n] = frame.step;
     data.hold_plane[n] = plane_index;
-    data.hold_wrapped[n] = wrapped || still_wrapped ? 1 : 0;
   }
 
   bool held_last_step_facing(int node, const Eigen::Vector3d& normal) const {
@@ -156,9 +148,6 @@ struct Writer {
 
   void paired_faces() {
     const double feasible_slack = model.params.contact_distance_m + model.params.skin_m;
-    // The soft body's centre: its bounding box's (Bullet updates m_bounds in predictMotion).
-    const btVector3 centre = 0.5 * (soft.m_bounds[0] + soft.m_bounds[1]);
-    const Eigen::Vector3d body_centre_world(centre.x(), centre.y(), centre.z());
     for (const int face : data.contacted_faces) {
       const int plane_index = data.face_plane[static_cast<std::size_t>(face)];
       const ToolPlane& plane = model.tool.planes()[static_cast<std::size_t>(plane_index)];
@@ -168,28 +157,13 @@ struct Writer {
       const int lead = data.face_lead_node[static_cast<std::size_t>(face)];
       const bool rim_leads = model.rim_plane[static_cast<std::size_t>(plane_index)] != 0 && lead >= 0 &&
                              data.node_facing[static_cast<std::size_t>(lead)] < -kRimHeadOnCosine;
-      // Only a rim that points into the body (its normal within 60° of the way to the body's
-      // centre: the edge of a blade pressed edge-first) marks the vertices it wraps for the retake
-      // in the hysteresis below. A face-first plate's side rim points sideways out of its dent;
-      // a vertex wrapped onto it and kept there hooks the rim while its neighbours go round it
-      // (measured: a 1 mm plate at 10 m/s left a triangle cut by its rim at the end of the hold,
-      // where faces only leave none, and the ball was pushed 28 mm sideways during the hold).
-      bool rim_points_in = false;
-      if (rim_leads) {
-        const Eigen::Vector3d normal_world = frame.r_cur * plane.normal_tool;
-        const Eigen::Vector3d rim_world = frame.r_cur * (plane.offset_m * plane.normal_tool) + frame.t_cur;
-        const Eigen::Vector3d to_centre = body_centre_world - rim_world;
-        rim_points_in = normal_world.dot(to_centre) > kRimHeadOnCosine * to_centre.norm();
-      }
       for (const int node : model.soft.face_nodes[static_cast<std::size_t>(face)]) {
         if (fixed(node)) continue;
         const double start_height = plane.normal_tool.dot(data.start_tool_m[static_cast<std::size_t>(node)]);
         const bool came_from_front = start_height >= plane.offset_m - feasible_slack;
-        if (came_from_front || held_last_step_facing(node, plane.normal_tool)) {
+        if (came_from_front || held_last_step_facing(node, plane.normal_tool) ||
+            (rim_leads && move_clears_tool(node, plane_index)))
           place_on_plane(node, plane_index);
-        } else if (rim_leads && move_clears_tool(node, plane_index)) {
-          place_on_plane(node, plane_index, rim_points_in);
-        }
       }
     }
   }
@@ -283,18 +257,7 @@ DisplacementCounts enforce_displacement(const CollisionModel& model, const StepF
     const ToolPlane& plane = planes[static_cast<std::size_t>(plane_index)];
     const double gap = plane.normal_tool.dot(data.end_tool_m[n]) - plane.offset_m;
     if (gap > release_m) continue;  // separated: released
-    if (gap < 0.0) {
-      // Pushed behind its plane with no tool node hitting it. A node wrapped round a leading rim
-      // (beside an edge-first blade, behind its rim plane) is lifted back up beside the blade by
-      // its springs: released, its triangle would span the blade above the edge — sliced — until a
-      // rim node hit it again and re-wrapped it, a contact-set change every step or two (the
-      // blade's hold chattered at 12–38 %). It is taken back onto the rim while that move clears
-      // the tool. Any other node is released.
-      if (data.hold_wrapped[n] != 0 && model.rim_plane[static_cast<std::size_t>(plane_index)] != 0 &&
-          !writer.fixed(node) && writer.move_clears_tool(node, plane_index))
-        writer.place_on_plane(node, plane_index, true);
-      continue;
-    }
+    if (gap < 0.0) continue;  // pushed behind its plane with no tool node hitting it: released
     const double u = release_m > 0.0 ? gap / release_m : 0.0;
     data.node_share[n] = 1.0 - u * u * (3.0 - 2.0 * u);  // smoothstep: flat at the face and at the release
     data.hold_stamp[n] = frame.step;  // lifted off the face it moves freely (only its side is remembered)
