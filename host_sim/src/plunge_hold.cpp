@@ -91,15 +91,16 @@ PlungeHoldResult run_plunge_hold(const SceneDescription& scene, SceneCollisionMe
     result.max_penetration_m = std::max(result.max_penetration_m, r.crossing.max_penetration_m);
     result.step_s.push_back(r.times.total_s);
   };
-  // Only for the hold window's steps (hold_trace): the plunge's steps are not traced.
-  auto trace = [&sim](const HostStepResult& r) {
-    HoldStepTrace t;
-    for (int p = 0; p < r.part_count; ++p) t.contacted_triangles += r.part_results[static_cast<std::size_t>(p)].contacted_triangles;
+  auto ball_centre = [&sim] {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     for (const Eigen::Vector3d& p : sim.node_positions_world_m()) sum += p;
     sum /= static_cast<double>(std::max<std::size_t>(1, sim.node_positions_world_m().size()));
-    t.ball_centre_world_m = Vec3{sum.x(), sum.y(), sum.z()};
-    return t;
+    return Vec3{sum.x(), sum.y(), sum.z()};
+  };
+  auto contacted_triangles = [](const HostStepResult& r) {
+    int count = 0;
+    for (int p = 0; p < r.part_count; ++p) count += r.part_results[static_cast<std::size_t>(p)].contacted_triangles;
+    return count;
   };
   while (pose.position_world_m.y() > end_y) {
     pose.position_world_m.y() = std::max(end_y, pose.position_world_m.y() - speed_m_s * dt);
@@ -108,14 +109,18 @@ PlungeHoldResult run_plunge_hold(const SceneDescription& scene, SceneCollisionMe
   const long settle_steps = std::lround(kHoldSettle_s / dt);
   const long hold_steps = std::lround(hold_s / dt);
   result.hold_force_n.reserve(static_cast<std::size_t>(hold_steps));
-  result.hold_trace.reserve(static_cast<std::size_t>(hold_steps));
+  int previous_triangles = -1;
   for (long i = 0; i < settle_steps + hold_steps; ++i) {
     const HostStepResult& r = sim.step(pose);
     record(r);
     if (i < settle_steps) continue;
     result.hold_force_n.push_back(r.force_on_tool_world_n.norm());
-    result.hold_trace.push_back(trace(r));
+    const int triangles = contacted_triangles(r);
+    if (i == settle_steps) result.ball_centre_hold_start_world_m = ball_centre();
+    else if (triangles != previous_triangles) ++result.hold_contact_set_changes;
+    previous_triangles = triangles;
   }
+  result.ball_centre_hold_end_world_m = ball_centre();
   result.hold = hold_force_stats(result.hold_force_n);
   return result;
 }

@@ -30,11 +30,9 @@ TEST_P(PairedSweepHold, NoCrossingNoPenetrationAndContactAtEverySpeed) {
   for (const double speed : kSpeedsMS) {
     const PlungeHoldResult c = run_plunge_hold(scene, SceneCollisionMethod::kPaired, speed, tool.leading_half_m, kHoldS);
     // The diagnosis beside the figure: does the contact set change, and does the ball move?
-    int set_changes = 0;
-    for (std::size_t i = 1; i < c.hold_trace.size(); ++i)
-      set_changes += c.hold_trace[i].contacted_triangles != c.hold_trace[i - 1].contacted_triangles ? 1 : 0;
-    const Vec3& a = c.hold_trace.front().ball_centre_world_m;
-    const Vec3& b = c.hold_trace.back().ball_centre_world_m;
+    const int set_changes = c.hold_contact_set_changes;
+    const Vec3& a = c.ball_centre_hold_start_world_m;
+    const Vec3& b = c.ball_centre_hold_end_world_m;
     std::printf("%-17s %5.1f m/s: crossed %d, penetration %.4f mm, F_hold %.3f N, jitter %.3f %% | contact-set changes %d, "
                 "ball centre moved (%.1f, %.1f) mm in x, z over the hold\n",
                 std::string(tool.name).c_str(), speed, c.crossed_nodes, c.max_penetration_m * 1e3, c.hold.mean_n, 100.0 * c.hold.jitter,

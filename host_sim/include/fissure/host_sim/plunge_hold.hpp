@@ -62,18 +62,15 @@ struct HoldForceStats {
 };
 [[nodiscard]] HoldForceStats hold_force_stats(const std::vector<double>& force_n);
 
-/// One step of the measured hold window, beside its force (hold_force_n): what the diagnosis of
-/// a jittery cell needs (is the contact set chattering, or is the ball moving?).
-struct HoldStepTrace {
-  int contacted_triangles = 0;      ///< triangles in the force set (paired/ray; 0 for bullet)
-  Vec3 ball_centre_world_m{};       ///< mean of the soft nodes
-};
-
 struct PlungeHoldResult {
   int crossed_nodes = 0, wrong_side_nodes = 0, inside_nodes = 0;  ///< worst step
   double max_penetration_m = 0.0;
   std::vector<double> hold_force_n;  ///< |F| per step of the measured hold window
-  std::vector<HoldStepTrace> hold_trace;  ///< per step of the measured hold window
+  // What the diagnosis of a jittery cell needs (is the contact set chattering, or is the ball
+  // moving?), over the measured hold window:
+  int hold_contact_set_changes = 0;   ///< steps whose force-set triangle count differs from the step before's
+  Vec3 ball_centre_hold_start_world_m{};  ///< mean of the soft nodes at the first hold step ...
+  Vec3 ball_centre_hold_end_world_m{};    ///< ... and at the last
   std::vector<double> step_s;        ///< wall time of every step (plunge and hold)
   HoldForceStats hold;
 };
