@@ -60,10 +60,10 @@ ToolPose interpolate(const ToolPose& a, const ToolPose& b, double s) {
 
 }  // namespace
 
-HostSimulation::HostSimulation(const SceneDescription& scene, std::optional<SceneCollisionMethod> method)
+HostSimulation::HostSimulation(const SceneDescription& scene, std::optional<SceneCollisionMethod> method, const HostSimulationOptions& options)
     : scene_(scene), method_(method.value_or(scene.simulation.collision_method)) {
   const bool bullet = method_ == SceneCollisionMethod::kBullet;
-  world_ = std::make_unique<SoftWorld>(scene_, bullet);
+  world_ = std::make_unique<SoftWorld>(scene_, bullet, bullet || options.solver_node_bounds);
   btSoftBody& soft = world_->soft();
   const int parts = world_->part_count();
   tool_pose_ = to_tool_pose(scene_.trajectory.start);
@@ -88,8 +88,9 @@ HostSimulation::HostSimulation(const SceneDescription& scene, std::optional<Scen
     for (int p = 0; p < parts; ++p) {
       params.jaw = p;
       const ToolNodes& nodes = tool_nodes_[static_cast<std::size_t>(p)];
-      collisions_[static_cast<std::size_t>(p)] = method_ == SceneCollisionMethod::kPaired ? make_paired_collision(nodes, soft, params)
-                                                                                          : make_ray_collision(nodes, soft, params);
+      SoftNodeBounds* bounds = world_->node_bounds();
+      collisions_[static_cast<std::size_t>(p)] = method_ == SceneCollisionMethod::kPaired ? make_paired_collision(nodes, soft, params, bounds)
+                                                                                          : make_ray_collision(nodes, soft, params, bounds);
     }
   }
   const ToolVolume volume = build_volume(scene_);

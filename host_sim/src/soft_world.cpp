@@ -102,16 +102,20 @@ void tool_part_poses(const SceneDescription& scene, const ToolPose& tool, double
   }
 }
 
-SoftWorld::SoftWorld(const SceneDescription& scene, bool tool_collides_in_bullet, bool probe_contacts)
+SoftWorld::SoftWorld(const SceneDescription& scene, bool tool_collides_in_bullet, bool instrumented_solver)
     : geometry_(tool_part_geometry(scene)), parts_in_world_(tool_collides_in_bullet) {
   configuration_ = std::make_unique<btSoftBodyRigidBodyCollisionConfiguration>();
   dispatcher_ = std::make_unique<btCollisionDispatcher>(configuration_.get());
   broadphase_ = std::make_unique<btDbvtBroadphase>();
   solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
-  if (tool_collides_in_bullet && probe_contacts) {
+  if (tool_collides_in_bullet && instrumented_solver) {
     auto probe = std::make_unique<ContactProbeSolver>();
     probe_ = probe.get();
     soft_solver_ = std::move(probe);
+  } else if (instrumented_solver) {
+    auto bounding = std::make_unique<NodeBoundsSolver>();
+    bounding_solver_ = bounding.get();
+    soft_solver_ = std::move(bounding);
   } else {
     soft_solver_ = std::make_unique<btDefaultSoftBodySolver>();
   }
@@ -196,6 +200,7 @@ SoftWorld::SoftWorld(const SceneDescription& scene, bool tool_collides_in_bullet
     for (int p = 0; p < geometry_.part_count; ++p) objects[static_cast<std::size_t>(p)] = parts_[static_cast<std::size_t>(p)].get();
     probe_->attach(soft_.get(), objects);
   }
+  if (bounding_solver_ != nullptr) bounding_solver_->attach(soft_.get());
 }
 
 SoftWorld::~SoftWorld() {

@@ -27,8 +27,9 @@ double seconds_between(Clock::time_point a, Clock::time_point b) { return std::c
 
 class ThinBodyCollisionImpl final : public ThinBodyCollision {
  public:
-  ThinBodyCollisionImpl(const ToolNodes& tool, const btSoftBody& soft, const ThinBodyCollisionParams& params, bool paired)
-      : model_(thin_body::build_collision_model(tool, soft, params, paired)), soft_(&soft) {
+  ThinBodyCollisionImpl(const ToolNodes& tool, const btSoftBody& soft, const ThinBodyCollisionParams& params, bool paired,
+                        SoftNodeBounds* node_bounds)
+      : model_(thin_body::build_collision_model(tool, soft, params, paired)), soft_(&soft), node_bounds_(node_bounds) {
     thin_body::allocate_collision_data(model_, data_);
   }
 
@@ -52,7 +53,7 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision {
     out.seconds_narrow = out.seconds_response = out.seconds_force = 0.0;
 
     frame_ = thin_body::make_step_frame(model_, data_.step, previous, current, dt_s);
-    out.broad_phase_hit = thin_body::broad_phase(model_, frame_, soft, data_);
+    out.broad_phase_hit = thin_body::broad_phase(model_, frame_, soft, data_, node_bounds_);
     const Clock::time_point t1 = Clock::now();
     out.seconds_broad = seconds_between(t0, t1);
     if (!out.broad_phase_hit) {
@@ -71,7 +72,7 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision {
     out.colliding_tool_nodes = static_cast<int>(data_.contact_nodes.size()) - out.excluded_pairs;
     const Clock::time_point t2 = Clock::now();
     out.seconds_narrow = seconds_between(t1, t2);
-    const thin_body::DisplacementCounts counts = thin_body::enforce_displacement(model_, frame_, soft, data_);
+    const thin_body::DisplacementCounts counts = thin_body::enforce_displacement(model_, frame_, soft, data_, node_bounds_);
     out.displaced_soft_nodes = counts.displaced;
     out.guard_corrections = counts.guard_corrections;
     const Clock::time_point t3 = Clock::now();
@@ -146,6 +147,7 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision {
       const Eigen::Vector3d out_world = r_cur * p_cur + current.position_world_m;
       node.m_x.setValue(static_cast<btScalar>(out_world.x()), static_cast<btScalar>(out_world.y()),
                         static_cast<btScalar>(out_world.z()));
+      if (node_bounds_ != nullptr) node_bounds_->extend(i, node.m_x);
       ++put_out;
     }
     return put_out;
@@ -155,19 +157,20 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision {
   thin_body::CollisionData data_;
   thin_body::StepFrame frame_;
   const btSoftBody* soft_;
+  SoftNodeBounds* node_bounds_;  // the solver's node bounds (null: the broad phase reads every node)
   bool had_contact_ = false;
 };
 
 }  // namespace
 
 std::unique_ptr<ThinBodyCollision> make_paired_collision(const ToolNodes& tool, const btSoftBody& soft,
-                                                         const ThinBodyCollisionParams& params) {
-  return std::make_unique<ThinBodyCollisionImpl>(tool, soft, params, true);
+                                                         const ThinBodyCollisionParams& params, SoftNodeBounds* node_bounds) {
+  return std::make_unique<ThinBodyCollisionImpl>(tool, soft, params, true, node_bounds);
 }
 
 std::unique_ptr<ThinBodyCollision> make_ray_collision(const ToolNodes& tool, const btSoftBody& soft,
-                                                      const ThinBodyCollisionParams& params) {
-  return std::make_unique<ThinBodyCollisionImpl>(tool, soft, params, false);
+                                                      const ThinBodyCollisionParams& params, SoftNodeBounds* node_bounds) {
+  return std::make_unique<ThinBodyCollisionImpl>(tool, soft, params, false, node_bounds);
 }
 
 }  // namespace fissure::host

@@ -127,6 +127,10 @@ struct Harness {
   ThinBodyCollisionParams params;
   thin_body::CollisionModel model;
   thin_body::CollisionData data;
+  // with_bounds: the broad phase reads node bounds as NodeBoundsSolver leaves them (every node's
+  // m_q and m_x, per block; taken here by brute force before each step) instead of every node.
+  bool with_bounds = false;
+  SoftNodeBounds bounds;
 
   Harness(int faces, const ToolNodes& t)
       : tool(t), model(thin_body::build_collision_model(tool, settled_sphere(world, faces).soft(), params, true)) {
@@ -144,7 +148,8 @@ struct Harness {
   thin_body::StepFrame step(const ToolPose& previous, const ToolPose& current, bool respond) {
     ++data.step;
     const thin_body::StepFrame frame = make_frame(model, data.step, previous, current);
-    const bool hit = thin_body::broad_phase(model, frame, world.soft(), data);
+    if (with_bounds) take_bounds();
+    const bool hit = thin_body::broad_phase(model, frame, world.soft(), data, with_bounds ? &bounds : nullptr);
     if (!hit) {
       std::fill(data.node_face.begin(), data.node_face.end(), -1);
       std::fill(data.node_age.begin(), data.node_age.end(), 0);
@@ -153,7 +158,7 @@ struct Harness {
     if (respond) {
       thin_body::sweep_tool_nodes(model, data);
       (void)thin_body::exclude_infeasible_pairs(model, data);
-      (void)thin_body::enforce_displacement(model, frame, world.soft(), data);
+      (void)thin_body::enforce_displacement(model, frame, world.soft(), data, with_bounds ? &bounds : nullptr);
       CollisionStepResult out;
       out.reserve_for(model.soft.face_count);
       thin_body::hunt_crossley_force(model, frame, world.soft(), data, out);
@@ -169,6 +174,21 @@ struct Harness {
   }
 
   std::set<int> candidate_faces() const { return {data.candidate_faces.begin(), data.candidate_faces.end()}; }
+
+  void take_bounds() {
+    const btSoftBody& soft = world.soft();
+    const int blocks = (soft.m_nodes.size() + SoftNodeBounds::kNodesPerBlock - 1) / SoftNodeBounds::kNodesPerBlock;
+    bounds.node_count = soft.m_nodes.size();
+    bounds.block_lo.assign(static_cast<std::size_t>(blocks), btVector3(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT));
+    bounds.block_hi.assign(static_cast<std::size_t>(blocks), -btVector3(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT));
+    bounds.all_lo = bounds.block_lo[0];
+    bounds.all_hi = bounds.block_hi[0];
+    for (int i = 0; i < soft.m_nodes.size(); ++i) {
+      bounds.extend(i, soft.m_nodes[i].m_q);
+      bounds.extend(i, soft.m_nodes[i].m_x);
+    }
+    bounds.valid = true;
+  }
 };
 
 void expect_candidate_nodes_are_the_vertices(Harness& h, const thin_body::StepFrame& frame) {
@@ -191,8 +211,10 @@ TEST(BroadPhase, RandomPosesGiveEveryNeededFaceAndNoOther) {
   std::mt19937 rng(5150);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   int poses_with_candidates = 0;
+  for (const bool with_bounds : {false, true})
   for (const int faces : {128, 1280}) {
     Harness h(faces, test_scene::plate_tool(0.004));
+    h.with_bounds = with_bounds;
     const Eigen::Vector3d centre(0, test_scene::kSphereRadius_m, 0);
     for (int trial = 0; trial < 150; ++trial) {
       h.world.step_dynamics();  // start (m_q) and end (m_x) positions differ
@@ -220,21 +242,24 @@ TEST(BroadPhase, RandomPosesGiveEveryNeededFaceAndNoOther) {
       const FaceSets expected = needed_faces(h.model, h.data, frame, h.world.soft(), memory);
       const thin_body::StepFrame used = h.step(previous, current, false);
       ASSERT_EQ(used.step, frame.step);
-      expect_between(h.candidate_faces(), expected, std::to_string(faces) + " faces, trial " + std::to_string(trial));
-      expect_reached_faces_decided_exactly(h.data, used.step, expected, std::to_string(faces) + " faces, trial " + std::to_string(trial));
+      const std::string where = std::to_string(faces) + " faces, trial " + std::to_string(trial) + (with_bounds ? ", node bounds" : "");
+      expect_between(h.candidate_faces(), expected, where);
+      expect_reached_faces_decided_exactly(h.data, used.step, expected, where);
       expect_candidate_nodes_are_the_vertices(h, used);
       poses_with_candidates += expected.needed.empty() ? 0 : 1;
     }
   }
-  EXPECT_GT(poses_with_candidates, 60) << "the random poses must mostly reach the sphere";
+  EXPECT_GT(poses_with_candidates, 120) << "the random poses must mostly reach the sphere";
 }
 
 // Through real plunges (the collision moving nodes, Bullet predicting them elsewhere, the tool
 // stopping dead at the bottom) and holds, at 0.1–50 m/s: never a needed face missing, never a
 // candidate that is not allowed.
 TEST(BroadPhase, PlungesAndHoldsGiveEveryNeededFaceAndNoOther) {
+  for (const bool with_bounds : {false, true})
   for (const double speed : {0.1, 2.0, 20.0, 50.0}) {
     Harness h(1280, test_scene::plate_tool(0.002));
+    h.with_bounds = with_bounds;
     ToolPose previous;
     previous.position_world_m = Eigen::Vector3d(0.003, 0.115, -0.002);
     int contact_steps = 0;
@@ -247,8 +272,9 @@ TEST(BroadPhase, PlungesAndHoldsGiveEveryNeededFaceAndNoOther) {
       const thin_body::StepFrame frame = make_frame(h.model, h.data.step + 1, previous, current);
       const FaceSets expected = needed_faces(h.model, h.data, frame, h.world.soft(), memory);
       (void)h.step(previous, current, true);
-      expect_between(h.candidate_faces(), expected, "speed " + std::to_string(speed) + " step " + std::to_string(s));
-      expect_reached_faces_decided_exactly(h.data, frame.step, expected, "speed " + std::to_string(speed) + " step " + std::to_string(s));
+      const std::string where = "speed " + std::to_string(speed) + " step " + std::to_string(s) + (with_bounds ? ", node bounds" : "");
+      expect_between(h.candidate_faces(), expected, where);
+      expect_reached_faces_decided_exactly(h.data, frame.step, expected, where);
       if (HasFailure()) return;
       contact_steps += h.data.contact_nodes.empty() ? 0 : 1;
       previous = current;
@@ -409,6 +435,60 @@ TEST(BroadPhase, PreFilterKeepsEveryFaceTheExactTestKeeps) {
   }
 }
 
+// Two tool parts share the solver's bounds (the clamp's jaws): the first part's enforced
+// displacement writes node positions after the bounds were taken, and the second part's broad
+// phase must still find those nodes. On a flat sheet (grid order: a block of nodes is a strip of
+// it), plate A plunges 30 mm in one step and lays the sheet's nodes under it on its bottom face,
+// which ends on the mid-plane of a static plate B: B must get the same candidates as when it
+// reads every node, although the bounds saw those nodes 30 mm away.
+TEST(BroadPhase, NodesMovedByAnotherPartAfterTheBoundsWereTakenAreFound) {
+  std::vector<std::set<int>> candidates_of_b;
+  for (const bool with_bounds : {false, true}) {
+    test_scene::SoftWorld world{false};
+    world.add_slab(0.1, 32);
+    const ToolNodes tool = test_scene::plate_tool(0.004);
+    const ThinBodyCollisionParams params;
+    const thin_body::CollisionModel model_a = thin_body::build_collision_model(tool, world.soft(), params, true);
+    const thin_body::CollisionModel model_b = thin_body::build_collision_model(tool, world.soft(), params, true);
+    thin_body::CollisionData data_a, data_b;
+    thin_body::allocate_collision_data(model_a, data_a);
+    thin_body::allocate_collision_data(model_b, data_b);
+    world.step_without_dynamics();
+    SoftNodeBounds bounds;
+    const btSoftBody& soft = world.soft();
+    bounds.node_count = soft.m_nodes.size();
+    const int blocks = (bounds.node_count + SoftNodeBounds::kNodesPerBlock - 1) / SoftNodeBounds::kNodesPerBlock;
+    const btVector3 large(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT);
+    bounds.block_lo.assign(static_cast<std::size_t>(blocks), large);
+    bounds.block_hi.assign(static_cast<std::size_t>(blocks), -large);
+    bounds.all_lo = large;
+    bounds.all_hi = -large;
+    for (int i = 0; i < soft.m_nodes.size(); ++i) {
+      bounds.extend(i, soft.m_nodes[i].m_q);
+      bounds.extend(i, soft.m_nodes[i].m_x);
+    }
+    bounds.valid = true;
+    SoftNodeBounds* shared = with_bounds ? &bounds : nullptr;
+    ToolPose a_from, a_to, b_pose;
+    a_from.position_world_m = Eigen::Vector3d(0, 0.003, 0);
+    b_pose.position_world_m = Eigen::Vector3d(0, -0.03, 0);
+    a_to.position_world_m = Eigen::Vector3d(0, -0.03 + 0.002, 0);  // A's bottom face on B's mid-plane
+    data_a.step = 1;
+    const thin_body::StepFrame frame_a = make_frame(model_a, 1, a_from, a_to);
+    ASSERT_TRUE(thin_body::broad_phase(model_a, frame_a, world.soft(), data_a, shared));
+    thin_body::sweep_tool_nodes(model_a, data_a);
+    (void)thin_body::exclude_infeasible_pairs(model_a, data_a);
+    (void)thin_body::enforce_displacement(model_a, frame_a, world.soft(), data_a, shared);
+    ASSERT_GT(data_a.moved_nodes.size(), 50u);
+    data_b.step = 1;
+    const thin_body::StepFrame frame_b = make_frame(model_b, 1, b_pose, b_pose);
+    (void)thin_body::broad_phase(model_b, frame_b, world.soft(), data_b, shared);
+    candidates_of_b.emplace_back(data_b.candidate_faces.begin(), data_b.candidate_faces.end());
+  }
+  EXPECT_FALSE(candidates_of_b[0].empty()) << "A's displaced nodes lie inside B";
+  EXPECT_EQ(candidates_of_b[1], candidates_of_b[0]);
+}
+
 TEST(BroadPhase, OutOfContactNoFaceIsTested) {
   Harness h(5120, test_scene::plate_tool(0.004));
   ToolPose previous;
@@ -422,6 +502,12 @@ TEST(BroadPhase, OutOfContactNoFaceIsTested) {
   EXPECT_EQ(h.data.broad_nodes_scanned, h.model.soft.node_count);
   EXPECT_EQ(h.data.broad_seed_nodes, 0);
   EXPECT_EQ(h.data.broad_faces_tested, 0);
+  // With the solver's node bounds the whole body is tested once and no node is read.
+  h.with_bounds = true;
+  (void)h.step(current, current, true);
+  EXPECT_TRUE(h.data.candidate_faces.empty());
+  EXPECT_EQ(h.data.broad_nodes_scanned, 0);
+  EXPECT_EQ(h.data.broad_seed_nodes, 0);
 }
 
 // The work for a fixed contact: a plate held on the sphere's top at the depth where about 24

@@ -76,6 +76,18 @@ constexpr int kScanPrefetchAhead = 16;
 
 Eigen::Vector3d to_eigen(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
 
+// A double bound rounded outwards to Bullet's float, so that a float position on the boundary is
+// never lost to rounding.
+float float_below(double v) { return std::nextafter(static_cast<float>(v), -std::numeric_limits<float>::infinity()); }
+float float_above(double v) { return std::nextafter(static_cast<float>(v), std::numeric_limits<float>::infinity()); }
+
+// The solver's whole-body bounds meet a world box.
+bool body_meets(const SoftNodeBounds& bounds, const Eigen::AlignedBox3d& box_world) {
+  return bounds.all_lo.x() <= float_above(box_world.max().x()) && bounds.all_hi.x() >= float_below(box_world.min().x()) &&
+         bounds.all_lo.y() <= float_above(box_world.max().y()) && bounds.all_hi.y() >= float_below(box_world.min().y()) &&
+         bounds.all_lo.z() <= float_above(box_world.max().z()) && bounds.all_hi.z() >= float_below(box_world.min().z());
+}
+
 Eigen::AlignedBox3d grown(const Eigen::AlignedBox3d& box, double by_m) {
   return {box.min() - Eigen::Vector3d::Constant(by_m), box.max() + Eigen::Vector3d::Constant(by_m)};
 }
@@ -99,6 +111,10 @@ struct Query {
   Eigen::AlignedBox3d near_world;     // world: seeds of near_tool faces (+ reach)
   Eigen::AlignedBox3d memory_world;   // world: seeds of memory_tool faces (+ reach; may be empty)
   Eigen::AlignedBox3d any_world;      // world: near_world ∪ memory_world (the scan's first test)
+  // World: the swept near / memory boxes without the seed reach. A needed face's own start/end
+  // world box meets them, and every face lies inside the bounds of all the nodes: a body whose
+  // node bounds miss this box has no face to collect (the whole-body test of the solver's bounds).
+  Eigen::AlignedBox3d faces_world;
 
   bool face_needed(const Eigen::AlignedBox3d& face_tool) const {
     return face_tool.intersects(near_tool) || (!memory_tool.isEmpty() && face_tool.intersects(memory_tool));
@@ -141,15 +157,17 @@ Query make_query(const CollisionModel& model, const StepFrame& frame, const Coll
   if (!q.memory_tool.isEmpty()) q.memory_tool = grown(q.memory_tool, memory_pad);
   // The padded tool-frame boxes are transformed corner by corner, so their world bounds hold the
   // pads whatever the orientation.
-  const auto world_of = [&](const Eigen::AlignedBox3d& box_tool) {
+  const auto world_of = [&](const Eigen::AlignedBox3d& box_tool, double reach_m) {
     const Eigen::AlignedBox3d world = swept_world(frame, box_tool);
-    return grown(world, reach + rotation_slack_m(model, frame, world.sizes().norm()));
+    return grown(world, reach_m + rotation_slack_m(model, frame, world.sizes().norm()));
   };
-  q.near_world = world_of(q.near_tool);
+  q.near_world = world_of(q.near_tool, reach);
   q.any_world = q.near_world;
+  q.faces_world = world_of(q.near_tool, 0.0);
   if (!q.memory_tool.isEmpty()) {
-    q.memory_world = world_of(q.memory_tool);
+    q.memory_world = world_of(q.memory_tool, reach);
     q.any_world.extend(q.memory_world);
+    q.faces_world.extend(world_of(q.memory_tool, 0.0));
   }
   return q;
 }
@@ -209,10 +227,8 @@ struct FloatBox {
   static FloatBox of(const Eigen::AlignedBox3d& box) {
     FloatBox out;
     if (box.isEmpty()) return out;
-    const auto below = [](double v) { return std::nextafter(static_cast<float>(v), -std::numeric_limits<float>::infinity()); };
-    const auto above = [](double v) { return std::nextafter(static_cast<float>(v), std::numeric_limits<float>::infinity()); };
-    out.lo = btVector3(below(box.min().x()), below(box.min().y()), below(box.min().z()));
-    out.hi = btVector3(above(box.max().x()), above(box.max().y()), above(box.max().z()));
+    out.lo = btVector3(float_below(box.min().x()), float_below(box.min().y()), float_below(box.min().z()));
+    out.hi = btVector3(float_above(box.max().x()), float_above(box.max().y()), float_above(box.max().z()));
     out.empty = false;
     return out;
   }
@@ -384,7 +400,8 @@ void prefetch_kept_faces(const CollisionModel& model, const CollisionData& data)
 
 }  // namespace
 
-bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data) {
+bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data,
+                 const SoftNodeBounds* node_bounds) {
   if (data.broad_listed_stamp.size() != static_cast<std::size_t>(model.soft.node_count)) {
     // First call: size the broad phase's own buffers (the step allocates nothing afterwards).
     data.broad_listed_stamp.assign(static_cast<std::size_t>(model.soft.node_count), -1);
@@ -404,34 +421,62 @@ bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSo
   data.broad_faces_kept.clear();
 
   const Query query = make_query(model, frame, data);
+  const bool bounds_usable = node_bounds != nullptr && node_bounds->valid && node_bounds->node_count == model.soft.node_count;
+  // Out of contact — nothing carried from last step and the body's bounds away from the tool: no
+  // face can be needed (Query::faces_world), and nothing else is touched. That matters: after
+  // Bullet's step this stage's code and data are cold, and its remaining setup and empty loops
+  // cost ~3 µs of cache misses doing nothing (measured on bench collision's 20 480-face sphere).
+  if (bounds_usable && data.broad_previous_candidates.empty() && !body_meets(*node_bounds, query.faces_world)) {
+    data.broad_scan_hits.clear();
+    return false;
+  }
   Collector collect(model, frame, soft, query, data);
 
-  // The scan (see the header comment), in Bullet's single precision: the union box is rounded
-  // outwards to float, so a node on its boundary is never lost to rounding.
-  const auto below = [](double v) { return std::nextafter(static_cast<float>(v), -std::numeric_limits<float>::infinity()); };
-  const auto above = [](double v) { return std::nextafter(static_cast<float>(v), std::numeric_limits<float>::infinity()); };
+  // The scan (see the header comment), in Bullet's single precision against the union box
+  // rounded outwards.
   const Eigen::AlignedBox3d& any = query.any_world;
-  const float lo_x = below(any.min().x()), lo_y = below(any.min().y()), lo_z = below(any.min().z());
-  const float hi_x = above(any.max().x()), hi_y = above(any.max().y()), hi_z = above(any.max().z());
+  const float lo_x = float_below(any.min().x()), lo_y = float_below(any.min().y()), lo_z = float_below(any.min().z());
+  const float hi_x = float_above(any.max().x()), hi_y = float_above(any.max().y()), hi_z = float_above(any.max().z());
   const int count = model.soft.node_count;
   data.broad_scan_hits.clear();
-  for (int i = 0; i < count; ++i) {
-    // Nodes are 256 bytes apart: a software prefetch this far ahead keeps enough misses in flight
-    // (measured on the 10 242-node sphere: 10 ns per node without it, 6 with it). m_x and m_q
-    // straddle a cache line when the node array sits at 32 mod 64 (m_x at 48 mod 64 on the bench's
-    // 20 480-face sphere): both lines are prefetched.
-    if (i + kScanPrefetchAhead < count) {
-      __builtin_prefetch(&soft.m_nodes[i + kScanPrefetchAhead].m_x);
-      __builtin_prefetch(&soft.m_nodes[i + kScanPrefetchAhead].m_q);
+  int scanned = 0;
+  // Nodes [first, last): the union box test on each, in memory order.
+  const auto scan = [&](int first, int last) {
+    for (int i = first; i < last; ++i) {
+      // Nodes are 256 bytes apart: a software prefetch this far ahead keeps enough misses in flight
+      // (measured on the 10 242-node sphere: 10 ns per node without it, 6 with it). m_x and m_q
+      // straddle a cache line when the node array sits at 32 mod 64 (m_x at 48 mod 64 on the bench's
+      // 20 480-face sphere): both lines are prefetched.
+      if (i + kScanPrefetchAhead < last) {
+        __builtin_prefetch(&soft.m_nodes[i + kScanPrefetchAhead].m_x);
+        __builtin_prefetch(&soft.m_nodes[i + kScanPrefetchAhead].m_q);
+      }
+      const btVector3& x = soft.m_nodes[i].m_x;
+      const btVector3& q = soft.m_nodes[i].m_q;
+      // Six independent compares and one branch (taken only near the tool).
+      const bool near = (std::min(x.x(), q.x()) <= hi_x) & (std::max(x.x(), q.x()) >= lo_x) & (std::min(x.y(), q.y()) <= hi_y) &
+                        (std::max(x.y(), q.y()) >= lo_y) & (std::min(x.z(), q.z()) <= hi_z) & (std::max(x.z(), q.z()) >= lo_z);
+      if (near) data.broad_scan_hits.push_back(i);
     }
-    const btVector3& x = soft.m_nodes[i].m_x;
-    const btVector3& q = soft.m_nodes[i].m_q;
-    // Six independent compares and one branch (taken only near the tool).
-    const bool near = (std::min(x.x(), q.x()) <= hi_x) & (std::max(x.x(), q.x()) >= lo_x) & (std::min(x.y(), q.y()) <= hi_y) &
-                      (std::max(x.y(), q.y()) >= lo_y) & (std::min(x.z(), q.z()) <= hi_z) & (std::max(x.z(), q.z()) >= lo_z);
-    if (near) data.broad_scan_hits.push_back(i);
+    scanned += last - first;
+  };
+  if (bounds_usable) {
+    // The solver's bounds of this step (node_bounds_solver.hpp): the whole body against the query
+    // without the seed reach, then only the blocks of nodes whose box meets the union box (the
+    // same test on a box: a node passing it lies in a block that passes it too).
+    if (body_meets(*node_bounds, query.faces_world)) {
+      constexpr int kBlock = SoftNodeBounds::kNodesPerBlock;
+      for (int b = 0; b < node_bounds->block_count(); ++b) {
+        const btVector3& lo = node_bounds->block_lo[static_cast<std::size_t>(b)];
+        const btVector3& hi = node_bounds->block_hi[static_cast<std::size_t>(b)];
+        if (lo.x() <= hi_x && hi.x() >= lo_x && lo.y() <= hi_y && hi.y() >= lo_y && lo.z() <= hi_z && hi.z() >= lo_z)
+          scan(b * kBlock, std::min(count, (b + 1) * kBlock));
+      }
+    }
+  } else {
+    scan(0, count);
   }
-  data.broad_nodes_scanned = count;
+  data.broad_nodes_scanned = scanned;
   // Everything the faces around these nodes read is cold after Bullet's step (a few thousand
   // misses on the finest mesh, ~60 µs when taken one after another): it is prefetched in stages,
   // each stage's misses in flight together, before the faces are reached in the usual order.

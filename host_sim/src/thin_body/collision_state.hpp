@@ -1,6 +1,7 @@
 #pragma once
 // Internal model (const, built once) and data (mutable, preallocated) of the thin-body collision,
 // and the pipeline stages (one file each) that read the model and update the data — MuJoCo style.
+#include <fissure/host_sim/node_bounds_solver.hpp>
 #include <fissure/host_sim/thin_body_collision.hpp>
 #include <fissure/host_sim/thin_tool.hpp>
 
@@ -152,8 +153,10 @@ void allocate_collision_data(const CollisionModel& model, CollisionData& data);
 
 // Stage 1 (broad_phase.cpp): swept tool bounds vs every soft node's start / end position; on a hit,
 // collects candidate soft nodes / faces and their tool-frame start / end positions. false = out
-// of contact.
-bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data);
+// of contact. `node_bounds`: this step's node bounds from the solver (NodeBoundsSolver), which
+// let it skip the nodes far from the tool; null (or not valid): every node is read.
+bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data,
+                 const SoftNodeBounds* node_bounds = nullptr);
 // Stage 2 (node_sweep.cpp): every tool node against the candidate triangles, swept over the step.
 void sweep_tool_nodes(const CollisionModel& model, CollisionData& data);
 // Load time: the bin-ordered node tables and per-plane bounds the sweep reads (fills bins' tables).
@@ -166,8 +169,10 @@ struct DisplacementCounts {
   int displaced = 0;
   int guard_corrections = 0;
 };
+// `node_bounds` (may be null) takes in every position it writes, so that another tool part's
+// broad phase later in the same step still reads conservative bounds.
 DisplacementCounts enforce_displacement(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft,
-                                        CollisionData& data);
+                                        CollisionData& data, SoftNodeBounds* node_bounds = nullptr);
 // Stage 5 (hunt_crossley_force.cpp): HC per contacted triangle, summed; fills out.contacts.
 void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft,
                          CollisionData& data, CollisionStepResult& out);

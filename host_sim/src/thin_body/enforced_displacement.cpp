@@ -233,7 +233,7 @@ struct Writer {
 }  // namespace
 
 DisplacementCounts enforce_displacement(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft,
-                                        CollisionData& data) {
+                                        CollisionData& data, SoftNodeBounds* node_bounds) {
   Writer writer{model, frame, soft, data, DisplacementCounts{}};
   data.moved_nodes.clear();
   if (model.paired) {
@@ -242,6 +242,9 @@ DisplacementCounts enforce_displacement(const CollisionModel& model, const StepF
   } else {
     writer.ray_only();
   }
+  // Every node written above is listed in moved_nodes (Writer::write).
+  if (node_bounds != nullptr)
+    for (const int node : data.moved_nodes) node_bounds->extend(node, soft.m_nodes[node].m_x);
   // Hysteresis: a node held last step and still within release_distance in front of its plane
   // stays colliding (not moved), with a share of its force that ramps (smoothstep) from 1 on the
   // face to 0 at release_distance (normal_displacement, hunt_crossley_force.cpp): the node's force

@@ -43,11 +43,19 @@ struct HostStepResult {
   double jaw_gap_m = 0.0;                                ///< clamp: the gap actually applied
 };
 
+struct HostSimulationOptions {
+  /// paired / ray: solve the soft body with a NodeBoundsSolver, whose node bounds let the broad
+  /// phase skip the nodes far from the tool. false: Bullet's stock solver, and the broad phase
+  /// reads every node (the same simulation, bit for bit: tests and the bench's A/B use it).
+  bool solver_node_bounds = true;
+};
+
 class HostSimulation {
  public:
   /// `method` overrides the scene's collision method. Throws std::invalid_argument /
   /// std::runtime_error when the tool or soft body cannot be built.
-  explicit HostSimulation(const SceneDescription& scene, std::optional<SceneCollisionMethod> method = std::nullopt);
+  explicit HostSimulation(const SceneDescription& scene, std::optional<SceneCollisionMethod> method = std::nullopt,
+                          const HostSimulationOptions& options = {});
   ~HostSimulation();
   HostSimulation(const HostSimulation&) = delete;
   HostSimulation& operator=(const HostSimulation&) = delete;

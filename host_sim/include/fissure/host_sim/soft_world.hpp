@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 
 #include "fissure/host_sim/bullet_collision.hpp"
+#include "fissure/host_sim/node_bounds_solver.hpp"
 #include "fissure/host_sim/scene_description.hpp"
 #include "fissure/host_sim/thin_tool.hpp"
 
@@ -47,10 +48,12 @@ void tool_part_poses(const SceneDescription& scene, const ToolPose& tool, double
 
 class SoftWorld {
  public:
-  /// `tool_collides_in_bullet`: add the tool parts to the world (the `bullet` method) and,
-  /// unless `probe_contacts` is false (tests: the stock reference), measure their contacts
-  /// with a ContactProbeSolver; otherwise Bullet's default soft body solver.
-  SoftWorld(const SceneDescription& scene, bool tool_collides_in_bullet, bool probe_contacts = true);
+  /// `tool_collides_in_bullet`: add the tool parts to the world (the `bullet` method) and
+  /// measure their contacts with a ContactProbeSolver. Otherwise (paired / ray) the soft body is
+  /// solved by a NodeBoundsSolver, which keeps the node bounds the thin-body broad phase reads.
+  /// `instrumented_solver` false: Bullet's default soft body solver instead of either (the
+  /// reference both reproduce exactly).
+  SoftWorld(const SceneDescription& scene, bool tool_collides_in_bullet, bool instrumented_solver = true);
   ~SoftWorld();
   SoftWorld(const SoftWorld&) = delete;
   SoftWorld& operator=(const SoftWorld&) = delete;
@@ -64,6 +67,8 @@ class SoftWorld {
   [[nodiscard]] const btRigidBody& part_body(int part) const noexcept { return *parts_[static_cast<std::size_t>(part)]; }
   /// Non-null only when the tool collides in Bullet.
   [[nodiscard]] ContactProbeSolver* probe() noexcept { return probe_; }
+  /// Non-null only when the tool does not collide in Bullet (and the solver is not the stock one).
+  [[nodiscard]] SoftNodeBounds* node_bounds() noexcept { return bounding_solver_ != nullptr ? &bounding_solver_->bounds() : nullptr; }
   [[nodiscard]] double sdf_voxel_m() const noexcept { return sdf_voxel_m_; }
   /// Soft nodes tied to the ground by [[soft_body.anchor]] (0: a free body).
   [[nodiscard]] int anchored_nodes_count() const noexcept { return anchored_nodes_count_; }
@@ -88,6 +93,7 @@ class SoftWorld {
   std::unique_ptr<btSequentialImpulseConstraintSolver> solver_;
   std::unique_ptr<btDefaultSoftBodySolver> soft_solver_;
   ContactProbeSolver* probe_ = nullptr;  // = soft_solver_ when probing
+  NodeBoundsSolver* bounding_solver_ = nullptr;  // = soft_solver_ for the paired / ray methods
   std::unique_ptr<btSoftRigidDynamicsWorld> world_;
   std::vector<std::unique_ptr<btCollisionShape>> shapes_;
   std::vector<std::unique_ptr<btDefaultMotionState>> motion_states_;

@@ -21,6 +21,8 @@ class btSoftBody;
 
 namespace fissure::host {
 
+struct SoftNodeBounds;  // node_bounds_solver.hpp
+
 enum class CollisionMethod { kPaired, kRay, kBullet };
 
 // What the Hunt-Crossley deformation x of a contacted triangle measures (docs/scenes.md).
@@ -179,11 +181,14 @@ class ThinBodyCollision {
 // rest areas) is taken from its positions now. The closed-surface orientation (outward normals) is
 // detected from the signed volume; an open sheet's outward side is the side its face normals
 // (Bullet's winding) point to. Throws std::invalid_argument on a body without faces.
+// `node_bounds`: the node bounds a NodeBoundsSolver keeps for `soft` (SoftWorld::node_bounds()),
+// read by the broad phase instead of every node, and extended by every position the collision
+// writes. Null: the broad phase reads every node (a world with Bullet's stock solver).
 std::unique_ptr<ThinBodyCollision> make_paired_collision(const ToolNodes& tool, const btSoftBody& soft,
-                                                         const ThinBodyCollisionParams& params);
+                                                         const ThinBodyCollisionParams& params, SoftNodeBounds* node_bounds = nullptr);
 // The same detection without the pairing / exclusion step and without the soft-node side memory:
 // every tool node in contact places its triangle on its own face (paper Fig. 3 right).
 std::unique_ptr<ThinBodyCollision> make_ray_collision(const ToolNodes& tool, const btSoftBody& soft,
-                                                      const ThinBodyCollisionParams& params);
+                                                      const ThinBodyCollisionParams& params, SoftNodeBounds* node_bounds = nullptr);
 
 }  // namespace fissure::host

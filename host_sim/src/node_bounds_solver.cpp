@@ -1,0 +1,80 @@
+// Bullet's soft-body solve with the per-block node bounds fused into its last node loop
+// (node_bounds_solver.hpp says why).
+#include "fissure/host_sim/node_bounds_solver.hpp"
+
+#include <algorithm>
+
+#include <BulletSoftBody/btSoftBody.h>
+
+namespace fissure::host {
+
+void NodeBoundsSolver::attach(btSoftBody* soft) {
+  soft_ = soft;
+  bounds_.node_count = soft->m_nodes.size();
+  const int blocks = (bounds_.node_count + SoftNodeBounds::kNodesPerBlock - 1) / SoftNodeBounds::kNodesPerBlock;
+  bounds_.block_lo.assign(static_cast<std::size_t>(blocks), btVector3(0, 0, 0));
+  bounds_.block_hi.assign(static_cast<std::size_t>(blocks), btVector3(0, 0, 0));
+  bounds_.valid = false;
+}
+
+void NodeBoundsSolver::solveConstraints(btScalar /*solver_dt*/) {
+  bounds_.valid = false;
+  // btDefaultSoftBodySolver::solveConstraints: every active body, in the world's order.
+  for (int i = 0; i < m_softBodySet.size(); ++i) {
+    btSoftBody* body = m_softBodySet[i];
+    if (!body->isActive()) continue;
+    // The fused path reproduces btSoftBody::solveConstraints only where its cluster passes do
+    // nothing and no drift pass follows the velocity update (drift rewrites m_q and m_v after it).
+    const bool reproducible = body == soft_ && body->m_clusters.size() == 0 && body->m_cfg.diterations == 0 &&
+                              body->m_cfg.piterations > 0 && body->m_nodes.size() == bounds_.node_count;
+    if (reproducible) {
+      solve_with_bounds(*body);
+    } else {
+      body->solveConstraints();
+    }
+  }
+}
+
+void NodeBoundsSolver::solve_with_bounds(btSoftBody& sb) {
+  // 1. Bullet's own solveConstraints with its position block switched off: cluster passes (no-ops
+  //    without clusters), link and anchor preparation, the velocity iterations.
+  const int position_iterations = sb.m_cfg.piterations;
+  sb.m_cfg.piterations = 0;
+  sb.solveConstraints();
+  sb.m_cfg.piterations = position_iterations;
+  // 2. Its position block, verbatim: the same solvers in the same order with the same ti.
+  for (int isolve = 0; isolve < position_iterations; ++isolve) {
+    const btScalar ti = isolve / static_cast<btScalar>(position_iterations);
+    for (int iseq = 0; iseq < sb.m_cfg.m_psequence.size(); ++iseq) btSoftBody::getSolver(sb.m_cfg.m_psequence[iseq])(&sb, 1, ti);
+  }
+  // 3. Its velocity update (same expression, so the same float results), with the bounds of
+  //    m_q and m_x taken in the same pass, one block of nodes at a time.
+  const btScalar vc = sb.m_sst.isdt * (1 - sb.m_cfg.kDP);
+  const int count = sb.m_nodes.size();
+  const btVector3 zero(0, 0, 0);
+  btVector3 all_lo(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT), all_hi(-BT_LARGE_FLOAT, -BT_LARGE_FLOAT, -BT_LARGE_FLOAT);
+  for (int b = 0, first = 0; first < count; ++b, first += SoftNodeBounds::kNodesPerBlock) {
+    const int last = std::min(count, first + SoftNodeBounds::kNodesPerBlock);
+    btVector3 lo = sb.m_nodes[first].m_x, hi = lo;
+    for (int i = first; i < last; ++i) {
+      btSoftBody::Node& n = sb.m_nodes[i];
+      n.m_v = (n.m_x - n.m_q) * vc;
+      n.m_f = zero;
+      lo.setMin(n.m_x);
+      lo.setMin(n.m_q);
+      hi.setMax(n.m_x);
+      hi.setMax(n.m_q);
+    }
+    bounds_.block_lo[static_cast<std::size_t>(b)] = lo;
+    bounds_.block_hi[static_cast<std::size_t>(b)] = hi;
+    all_lo.setMin(lo);
+    all_hi.setMax(hi);
+  }
+  bounds_.all_lo = all_lo;
+  bounds_.all_hi = all_hi;
+  bounds_.valid = count > 0;
+  // 4. What follows the velocity update in Bullet (drift: excluded above; dampClusters /
+  //    applyClusters(true): no-ops without clusters, and already run in step 1).
+}
+
+}  // namespace fissure::host
