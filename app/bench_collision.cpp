@@ -389,6 +389,42 @@ nlohmann::json run_bench(const BenchOptions& o) {
       summary["coarse_faces"] = coarse;
       summary["fine_faces"] = fine;
       out["scaling_summary"] = summary;
+      // What the node bounds cost where they are taken, inside Bullet's solve (NodeBoundsSolver,
+      // not in the collision times above): the finest ball out of contact, solved by the fused
+      // solve and by Bullet's stock one (the same simulation, bit for bit), steps interleaved
+      // and the order alternated so that neither always runs on the other's cache.
+      {
+        const SceneDescription scene = sphere_scene(mesh_faces.back(), true);
+        HostSimulation fused(scene, SceneCollisionMethod::kPaired, host::HostSimulationOptions{true});
+        HostSimulation stock(scene, SceneCollisionMethod::kPaired, host::HostSimulationOptions{false});
+        host::ToolPose pose = host::to_tool_pose(scene.trajectory.start);
+        pose.position_world_m.y() = 0.3;
+        for (HostSimulation* sim : {&fused, &stock}) {
+          (void)sim->step(pose);
+          sim->settle(0.05);
+        }
+        std::vector<double> fused_s, stock_s;
+        for (long i = 0; i < 2 * samples; ++i) {
+          HostSimulation& first = i % 2 == 0 ? fused : stock;
+          HostSimulation& second = i % 2 == 0 ? stock : fused;
+          const double first_s = first.step(pose).times.bullet_s;
+          const double second_s = second.step(pose).times.bullet_s;
+          fused_s.push_back(i % 2 == 0 ? first_s : second_s);
+          stock_s.push_back(i % 2 == 0 ? second_s : first_s);
+        }
+        // The ratio of each adjacent pair of steps, then its median: the VM's load drifts on a
+        // scale of many steps, and a pair sees the same load.
+        std::vector<double> pair_ratio;
+        for (std::size_t i = 0; i < fused_s.size(); ++i) pair_ratio.push_back(fused_s[i] / stock_s[i]);
+        const double fused_us = sim_quantile(fused_s, 0.5) * 1e6, stock_us = sim_quantile(stock_s, 0.5) * 1e6;
+        const double ratio = sim_quantile(pair_ratio, 0.5);
+        std::printf("node bounds inside Bullet's solve (%d faces, out of contact, %ld interleaved steps each): Bullet step median %.1f us fused vs "
+                    "%.1f us stock; median pair ratio %.3f (quartiles %.3f-%.3f)\n",
+                    fused.soft_face_count(), 2 * samples, fused_us, stock_us, ratio, sim_quantile(pair_ratio, 0.25), sim_quantile(pair_ratio, 0.75));
+        out["solver_bounds_ab"] = {{"faces", fused.soft_face_count()}, {"samples", 2 * samples}, {"bullet_step_median_us_fused", fused_us},
+                                   {"bullet_step_median_us_stock", stock_us}, {"ratio", ratio},
+                                   {"ratio_quartiles", {sim_quantile(pair_ratio, 0.25), sim_quantile(pair_ratio, 0.75)}}};
+      }
       std::printf("targets: out/in collision (worst mesh) %.3f (<= 0.05); same contact %d->%d faces %.2fx (<= 2); same press per triangle %.2fx (<= 2)\n",
                   worst_out_ratio, coarse, fine, summary.value("same_contact_collision_ratio_fine_over_coarse", 0.0),
                   summary.value("same_press_per_triangle_ratio_fine_over_coarse", 0.0));
