@@ -115,28 +115,34 @@ struct Query {
   Eigen::AlignedBox3d near_tool;      // tool frame: tool bounds + near_pad
   Eigen::AlignedBox3d release_tool;   // tool frame: tool bounds + release pad (nodes held last step)
   Eigen::AlignedBox3d memory_tool;    // tool frame: last step's contact nodes + memory_pad (may be empty)
-  Eigen::AlignedBox3d near_world;     // world: seeds of near_tool faces (+ reach)
-  Eigen::AlignedBox3d memory_world;   // world: seeds of memory_tool faces (+ reach; may be empty)
-  Eigen::AlignedBox3d any_world;      // world: near_world ∪ memory_world (the scan's first test)
-  // World: the swept near / memory boxes without the seed reach. A needed face's own start/end
-  // world box meets them, and every face lies inside the bounds of all the nodes: a body whose
-  // node bounds miss this box has no face to collect (the whole-body test of the solver's bounds).
+  // World: the swept near / memory boxes (their union). A needed face's own start/end world box
+  // meets it, and every face lies inside the bounds of all the nodes: a body whose node bounds
+  // miss this box has no face to collect (the whole-body test of the solver's bounds).
   Eigen::AlignedBox3d faces_world;
+  // World: the seed boxes of the near and of the memory query — each swept box grown by the
+  // longest (stretched) edge and cut back to the swept box on the side the soft body lies (see
+  // seed_box()) — and their union (the scan's first test). Kept apart: a plate held on a ball
+  // has a memory query a few mm round its contact patch, and the union's box would take the
+  // memory query's depth under the whole plate.
+  Eigen::AlignedBox3d near_seed_world;
+  Eigen::AlignedBox3d memory_seed_world;  // may be empty
+  Eigen::AlignedBox3d any_seed_world;
 
   bool face_needed(const Eigen::AlignedBox3d& face_tool) const {
     return face_tool.intersects(near_tool) || (!memory_tool.isEmpty() && face_tool.intersects(memory_tool));
   }
   bool seed(const Eigen::AlignedBox3d& node_world) const {
-    return node_world.intersects(near_world) || (!memory_world.isEmpty() && node_world.intersects(memory_world));
+    return node_world.intersects(near_seed_world) || (!memory_seed_world.isEmpty() && node_world.intersects(memory_seed_world));
   }
 };
 
-// A soft triangle can cross the padded region with every vertex outside it: seeds are taken this
-// much further out. Every point of a triangle lies within (longest edge)/√3 of its nearest vertex
-// (the circumradius bound of an acute triangle; half the longest edge for an obtuse one), and an
-// edge is allowed to stretch to kStretchAllowance times its rest length.
+// A soft triangle can cross the padded region with every vertex outside it, so faces are reached
+// through seeds further out: every vertex of a triangle lies within its longest edge of every
+// other point of it, and an edge is allowed to stretch to kStretchAllowance times its rest
+// length (for a face's start and its end triangle alike, so a face's start/end box lies within
+// that much of each of its vertices' own start/end boxes).
 constexpr double kStretchAllowance = 2.0;
-double seed_reach_m(const CollisionModel& model) { return kStretchAllowance * model.soft.max_rest_edge_m / std::sqrt(3.0); }
+double seed_reach_m(const CollisionModel& model) { return kStretchAllowance * model.soft.max_rest_edge_m; }
 
 double near_pad_m(const CollisionModel& model) { return model.params.contact_distance_m + model.params.skin_m; }
 double release_pad_m(const CollisionModel& model) { return std::max(model.params.contact_distance_m, model.params.release_distance_m) + model.params.skin_m; }
@@ -148,6 +154,36 @@ double memory_pad_m(const CollisionModel& model) { return model.memory_depth_m +
 double rotation_slack_m(const CollisionModel& model, const StepFrame& frame, double query_size_m) {
   const double angle = frame.angular_velocity_world.norm() * frame.dt_s;
   return 0.25 * angle * ((frame.t_cur - frame.t_prev).norm() + query_size_m + 2.0 * seed_reach_m(model));
+}
+
+// The seed box of a query. A needed face F meets the query's swept box Q, so on every axis k F's highest vertex box
+// reaches Q.min_k and its lowest reaches down to Q.max_k — and each vertex box lies within the
+// reach of F. So the seeds may be cut on ANY one side without losing a needed face: on the side
+// the soft body lies, the band of nodes under a plate pressed into it (most of the reach band:
+// bench collision's 20 480-face same contact, 247 seeds for 24 candidate faces) is not read.
+// Which side: the one the body's rest bounds extend furthest beyond Q (any choice is exact; this
+// one is the same on every path, whatever the current positions).
+Eigen::AlignedBox3d seed_box(const CollisionModel& model, const Eigen::AlignedBox3d& swept_world_box, const Eigen::AlignedBox3d& grown_world) {
+  const Eigen::AlignedBox3d& faces_world = swept_world_box;
+  Eigen::AlignedBox3d seed = grown_world;
+  const Eigen::AlignedBox3d& body = model.soft.rest_bounds_world_m;
+  if (body.isEmpty()) return seed;
+  int best_axis = -1;
+  bool best_below = false;
+  double best_m = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    const double below_m = faces_world.min()[k] - body.min()[k];
+    const double above_m = body.max()[k] - faces_world.max()[k];
+    if (below_m > best_m) best_m = below_m, best_axis = k, best_below = true;
+    if (above_m > best_m) best_m = above_m, best_axis = k, best_below = false;
+  }
+  if (best_axis < 0) return seed;
+  if (best_below) {
+    seed.min()[best_axis] = std::min(seed.max()[best_axis], faces_world.min()[best_axis]);
+  } else {
+    seed.max()[best_axis] = std::max(seed.min()[best_axis], faces_world.max()[best_axis]);
+  }
+  return seed;
 }
 
 Query make_query(const CollisionModel& model, const StepFrame& frame, const CollisionData& data) {
@@ -168,13 +204,14 @@ Query make_query(const CollisionModel& model, const StepFrame& frame, const Coll
     const Eigen::AlignedBox3d world = swept_world(frame, box_tool);
     return grown(world, reach_m + rotation_slack_m(model, frame, world.sizes().norm()));
   };
-  q.near_world = world_of(q.near_tool, reach);
-  q.any_world = q.near_world;
   q.faces_world = world_of(q.near_tool, 0.0);
+  q.near_seed_world = seed_box(model, q.faces_world, world_of(q.near_tool, reach));
+  q.any_seed_world = q.near_seed_world;
   if (!q.memory_tool.isEmpty()) {
-    q.memory_world = world_of(q.memory_tool, reach);
-    q.any_world.extend(q.memory_world);
-    q.faces_world.extend(world_of(q.memory_tool, 0.0));
+    const Eigen::AlignedBox3d memory_world = world_of(q.memory_tool, 0.0);
+    q.faces_world.extend(memory_world);
+    q.memory_seed_world = seed_box(model, memory_world, world_of(q.memory_tool, reach));
+    q.any_seed_world.extend(q.memory_seed_world);
   }
   return q;
 }
@@ -251,7 +288,7 @@ class Collector {
       : model_(model), frame_(frame), soft_(soft), query_(query), data_(data), bounds_(frame),
         near_(FloatBox::of(query.near_tool)), memory_(FloatBox::of(query.memory_tool)), release_(FloatBox::of(query.release_tool)) {}
 
-  // A seed: a node whose own start/end box meets the world query (every face around it is reached).
+  // A seed: a node whose own start/end box meets a seed box (every face around it is reached).
   bool is_seed(int node) const {
     const btSoftBody::Node& n = soft_.m_nodes[node];
     Eigen::AlignedBox3d box(to_eigen(n.m_x));
@@ -439,9 +476,9 @@ bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSo
   }
   Collector collect(model, frame, soft, query, data);
 
-  // The scan (see the header comment), in Bullet's single precision against the union box
-  // rounded outwards.
-  const Eigen::AlignedBox3d& any = query.any_world;
+  // The scan (see the header comment), in Bullet's single precision against the union of the
+  // seed boxes rounded outwards.
+  const Eigen::AlignedBox3d& any = query.any_seed_world;
   const float lo_x = float_below(any.min().x()), lo_y = float_below(any.min().y()), lo_z = float_below(any.min().z());
   const float hi_x = float_above(any.max().x()), hi_y = float_above(any.max().y()), hi_z = float_above(any.max().z());
   const int count = model.soft.node_count;
@@ -469,7 +506,7 @@ bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSo
   };
   if (bounds_usable) {
     // The solver's bounds of this step (node_bounds_solver.hpp): the whole body against the query
-    // without the seed reach, then only the blocks of nodes whose box meets the union box (the
+    // without the seed reach, then only the blocks of nodes whose box meets the seed boxes' union (the
     // same test on a box: a node passing it lies in a block that passes it too).
     if (body_meets(*node_bounds, query.faces_world)) {
       constexpr int kBlock = SoftNodeBounds::kNodesPerBlock;
@@ -488,7 +525,7 @@ bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSo
   // misses on the finest mesh, ~60 µs when taken one after another): it is prefetched in stages,
   // each stage's misses in flight together, before the faces are reached in the usual order.
   // Only the seeds' faces: the scan's union box also takes in nodes between the near and the
-  // memory query (437 hits for 247 seeds on the bench's 20 480-face sphere).
+  // memory query.
   std::size_t seeds = 0;
   for (const int node : data.broad_scan_hits)
     if (collect.is_seed(node)) data.broad_scan_hits[seeds++] = node;

@@ -50,7 +50,11 @@ ToolNodeBins build_bins(const ToolNodes& tool) {
 
 void take_rest_state(const btSoftBody& soft, SoftSurfaceModel& model) {
   model.rest_node_world_m.resize(static_cast<std::size_t>(model.node_count));
-  for (int i = 0; i < model.node_count; ++i) model.rest_node_world_m[static_cast<std::size_t>(i)] = to_eigen(soft.m_nodes[i].m_x);
+  model.rest_bounds_world_m.setEmpty();
+  for (int i = 0; i < model.node_count; ++i) {
+    model.rest_node_world_m[static_cast<std::size_t>(i)] = to_eigen(soft.m_nodes[i].m_x);
+    model.rest_bounds_world_m.extend(model.rest_node_world_m[static_cast<std::size_t>(i)]);
+  }
   // With pose matching, the rest positions are also kept in the shape-matching frame (com from the
   // settled positions with Bullet's own weights, rotation from its last fit), for
   // HuntCrossleyParams::rest_frame = pose_matched (hunt_crossley_force.cpp).

@@ -35,6 +35,7 @@ struct SoftSurfaceModel {
   std::vector<double> rest_area_m2;
   double outward_sign = 1.0;   // multiplies Bullet's winding normal to point out of the soft body
   double max_rest_edge_m = 0.0;
+  Eigen::AlignedBox3d rest_bounds_world_m;  // bounds of rest_node_world_m (the broad phase's seed clip side)
 };
 
 // Uniform 2-D grid of the tool nodes over the two non-thin axes (tool frame), so a soft triangle
