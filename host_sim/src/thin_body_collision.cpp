@@ -52,6 +52,11 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision {
     out.guard_corrections = 0;
     out.seconds_narrow = out.seconds_response = out.seconds_force = 0.0;
 
+    if (!had_contact_ && thin_body::broad_phase_out_of_reach(model_, previous, current, node_bounds_, data_)) {
+      out.broad_phase_hit = false;
+      out.seconds_broad = seconds_between(t0, Clock::now());
+      return;
+    }
     frame_ = thin_body::make_step_frame(model_, data_.step, previous, current, dt_s);
     out.broad_phase_hit = thin_body::broad_phase(model_, frame_, soft, data_, node_bounds_);
     const Clock::time_point t1 = Clock::now();

@@ -444,6 +444,34 @@ void prefetch_kept_faces(const CollisionModel& model, const CollisionData& data)
 
 }  // namespace
 
+bool broad_phase_out_of_reach(const CollisionModel& model, const ToolPose& previous, const ToolPose& current,
+                              const SoftNodeBounds* node_bounds, CollisionData& data) {
+  if (node_bounds == nullptr || !node_bounds->valid || node_bounds->node_count != model.soft.node_count) return false;
+  // The padded tool box's bounding sphere at both poses: its swept box holds every corner of the
+  // box at either pose, so it holds Query::faces_world's swept near box; the rotation slack is
+  // bounded with that box's size (|centre move| + 2√3·radius) and the turn from the quaternions.
+  const Eigen::AlignedBox3d near_tool = grown(model.tool.bounds_tool_m(), near_pad_m(model));
+  const Eigen::Vector3d centre_tool = near_tool.center();
+  const double radius_m = 0.5 * near_tool.sizes().norm();
+  const Eigen::Vector3d centre_prev = previous.orientation_world * centre_tool + previous.position_world_m;
+  const Eigen::Vector3d centre_cur = current.orientation_world * centre_tool + current.position_world_m;
+  const double cos_half = std::min(1.0, std::abs(previous.orientation_world.normalized().dot(current.orientation_world.normalized())));
+  const double angle = 2.0 * std::acos(cos_half);
+  const double move_m = (current.position_world_m - previous.position_world_m).norm();
+  const double slack_m =
+      0.25 * angle * (move_m + (centre_cur - centre_prev).norm() + 2.0 * std::sqrt(3.0) * radius_m + 2.0 * seed_reach_m(model));
+  Eigen::AlignedBox3d box(centre_prev);
+  box.extend(centre_cur);
+  if (body_meets(*node_bounds, grown(box, radius_m + slack_m))) return false;
+  data.candidate_nodes.clear();
+  data.candidate_faces.clear();
+  data.broad_nodes_scanned = 0;
+  data.broad_seed_nodes = 0;
+  data.broad_faces_tested = 0;
+  data.broad_faces_transformed = 0;
+  return true;
+}
+
 bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data,
                  const SoftNodeBounds* node_bounds) {
   if (data.broad_listed_stamp.size() != static_cast<std::size_t>(model.soft.node_count)) {
@@ -535,7 +563,7 @@ bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSo
   prefetch_faces_around(model, soft, data, data.broad_scan_hits);
   for (const int node : data.broad_previous_candidates) collect.reach_faces_around(node);
   for (const int node : data.broad_scan_hits) collect.reach_faces_around(node);
-  // The exact test, in the order the faces were reached (so candidate_nodes keeps its order).
+  // The exact test, in the order the faces were reached.
   prefetch_kept_faces(model, data);
   collect.test_kept_faces();
   // A canonical order for the later stages: the node sweep gives a tool node to the FIRST of
@@ -543,6 +571,11 @@ bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSo
   // traversal order would otherwise decide contacts (clamp scenes: ±25 % peak force between two
   // orders). Face index order does not depend on how the faces were reached.
   std::sort(data.candidate_faces.begin(), data.candidate_faces.end());
+  // And the candidate nodes in index order: the response visits them in this order and the
+  // first moved node round a face gives it its force plane, so the order the faces were reached
+  // in (which depends on the seeds) would otherwise reach the force — and, through a haptic
+  // loop, the trajectory.
+  std::sort(data.candidate_nodes.begin(), data.candidate_nodes.end());
   return !data.candidate_faces.empty();
 }
 

@@ -158,6 +158,13 @@ void allocate_collision_data(const CollisionModel& model, CollisionData& data);
 // let it skip the nodes far from the tool; null (or not valid): every node is read.
 bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data,
                  const SoftNodeBounds* node_bounds = nullptr);
+// Stage 1's first test, before the step's frame is even built (out of contact its code and data
+// are all that is touched after Bullet's step): true when the tool, padded and swept, cannot meet
+// the solver's whole-body bounds — the broad phase would find nothing. Only for a step after one
+// with no candidate (so no side memory and no held node to re-test); false without valid bounds.
+// On true it leaves `data` as broad_phase() would (no candidates, zero counts).
+bool broad_phase_out_of_reach(const CollisionModel& model, const ToolPose& previous, const ToolPose& current,
+                              const SoftNodeBounds* node_bounds, CollisionData& data);
 // Stage 2 (node_sweep.cpp): every tool node against the candidate triangles, swept over the step.
 void sweep_tool_nodes(const CollisionModel& model, CollisionData& data);
 // Load time: the bin-ordered node tables and per-plane bounds the sweep reads (fills bins' tables).
