@@ -20,14 +20,15 @@
 //   * every vertex of those faces (candidate nodes, with their tool-frame start/end positions).
 // The test is exact on that criterion (tests/host_sim/broad_phase_test.cpp compares it with brute
 // force). Faces are reached through seed nodes, soft nodes whose own start/end box (m_q, m_x) meets
-// the world query — the swept padded tool bounds grown by two rest edge lengths (a large triangle
-// can cross the tool with all three vertices outside it):
+// a seed box: each query's swept world box grown by the longest stretched edge (a large triangle
+// can cross the tool with all three vertices outside it) and cut back to the swept box on the
+// side the soft body lies (seed_box() says why that loses no face):
 //   0. With the solver's node bounds (node_bounds_solver.hpp: per 32 nodes, every node's m_q and
 //      m_x after the solve, fused into Bullet's own last pass over the nodes; extended by the
 //      collision's own writes): the whole body's box is tested against the query WITHOUT the
 //      seed reach — every face lies inside the bounds of all nodes — and out of contact that is
 //      all that runs. In contact only the nodes of blocks whose box meets the union box are read
-//      (bench collision, 20 480 faces, same contact: 1 024 of 10 242 nodes). Without them:
+//      (bench collision, 20 480 faces, same contact: 704 of 10 242 nodes). Without them:
 //   1. EVERY soft node is tested, from the very positions the narrow phase uses. Bullet's node tree
 //      (btSoftBody::m_ndbvt) is not used: Bullet fits each leaf around the node's PREDICTED
 //      position, then pose matching and the constraint solver move the node — 15-25 mm after a
@@ -40,19 +41,14 @@
 //      ~60 µs a step in or out of contact, vs ~2 µs for the old out-of-contact root test; in
 //      contact it is cheaper than the tree walk it replaces (~2000 cold tree nodes for a fixed
 //      contact on the 20 480-face sphere).
-//      Why not a cheaper exact early-out (measured 2026-11-22, bench collision's 20 480-face sphere,
-//      10 242 nodes): the only sound alternative is a refit after Bullet's solver — e.g. a
-//      btDefaultSoftBodySolver subclass whose (virtual) updateSoftBodies does Bullet's own post-
-//      solve node pass (btSoftBody::updateNormals, 526-649 µs a step here) and keeps per-64-node
-//      bounds of m_x/m_q in the same loop: +38-48 µs a step (fused into the face loop instead:
-//      +390 µs), i.e. about what this scan costs (48-75 µs), moved into Bullet's step — and it
-//      would have to be charged to the collision. A per-node seed reach from the rest edges
-//      (longest edge of the node's own faces instead of the mesh's) is 98 % of the global one on
-//      the icospheres (2 % fewer seeds), not worth a table.
+//      (A separate bounds pass after Bullet's solve was measured on 2026-11-22 at +38-48 µs a
+//      step on 10 242 nodes — the nodes are cold again by then; fused into the solve's own last
+//      node loop, as NodeBoundsSolver does, it costs ~5 instructions a node: 0. above.)
 //   2. The faces around last step's candidate nodes are re-tested directly: a node held on the tool
 //      last step keeps its faces for the release band even where the seed query does not reach.
 //   3. Most faces reached through the seeds lie in the seed band only and are rejected (bench
-//      collision's 20 480-face same_contact hold: 247 seeds reach 552 faces for 24 candidates).
+//      collision's 20 480-face same_contact hold: 247 seeds reached 552 faces for 24 candidates
+//      before the seed boxes were cut back on the body's side, 45 seeds reach 116 now).
 //      Each reached face is first tested from its vertices' WORLD bounds (m_q box, m_x box, in
 //      Bullet's float with SIMD), carried into the tool frame whole (Arvo's box transform, see
 //      ToolFrameBounds): every tool-frame start/end position of a vertex lies in those carried
