@@ -445,14 +445,14 @@ bool broad_phase_out_of_reach(const CollisionModel& model, const ToolPose& previ
   if (node_bounds == nullptr || !node_bounds->valid || node_bounds->node_count != model.soft.node_count) return false;
   // The padded tool box's bounding sphere at both poses: its swept box holds every corner of the
   // box at either pose, so it holds Query::faces_world's swept near box; the rotation slack is
-  // bounded with that box's size (|centre move| + 2√3·radius) and the turn from the quaternions.
-  const Eigen::AlignedBox3d near_tool = grown(model.tool.bounds_tool_m(), near_pad_m(model));
-  const Eigen::Vector3d centre_tool = near_tool.center();
-  const double radius_m = 0.5 * near_tool.sizes().norm();
+  // bounded with that box's size (|centre move| + 2√3·radius) and the turn θ from the quaternions,
+  // θ ≤ π·sin(θ/2) = π·√(1 − (q₀·q₁)²) (no acos: after Bullet's step even libm's code is cold).
+  const Eigen::Vector3d& centre_tool = model.near_sphere_centre_tool_m;
+  const double radius_m = model.near_sphere_radius_m;
   const Eigen::Vector3d centre_prev = previous.orientation_world * centre_tool + previous.position_world_m;
   const Eigen::Vector3d centre_cur = current.orientation_world * centre_tool + current.position_world_m;
   const double cos_half = std::min(1.0, std::abs(previous.orientation_world.normalized().dot(current.orientation_world.normalized())));
-  const double angle = 2.0 * std::acos(cos_half);
+  const double angle = 3.14159265358979323846 * std::sqrt(1.0 - cos_half * cos_half);
   const double move_m = (current.position_world_m - previous.position_world_m).norm();
   const double slack_m =
       0.25 * angle * (move_m + (centre_cur - centre_prev).norm() + 2.0 * std::sqrt(3.0) * radius_m + 2.0 * seed_reach_m(model));

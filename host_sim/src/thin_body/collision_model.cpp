@@ -106,7 +106,7 @@ CollisionModel build_collision_model(const ToolNodes& tool, const btSoftBody& so
   if (!(hc.k >= 0.0) || !(hc.lambda >= 0.0) || !(hc.n > 0.0) || !std::isfinite(hc.k) || !std::isfinite(hc.lambda) ||
       !std::isfinite(hc.n))
     throw std::invalid_argument("thin-body collision: Hunt-Crossley k, lambda >= 0 and n > 0 (finite)");
-  CollisionModel model{tool, build_bins(tool), SoftSurfaceModel{}, params, paired, 0.0, {}};
+  CollisionModel model{tool, build_bins(tool), SoftSurfaceModel{}, params, paired, 0.0, Eigen::Vector3d::Zero(), 0.0, {}};
   prepare_node_sweep(model.tool, model.bins);
   SoftSurfaceModel& surface = model.soft;
   surface.node_count = soft.m_nodes.size();
@@ -132,6 +132,9 @@ CollisionModel build_collision_model(const ToolNodes& tool, const btSoftBody& so
   // A node already in contact may start a step this far behind its triangle (the soft solver
   // pushing a held node back a little) and still be in contact; further behind is another surface.
   model.memory_depth_m = std::max(tool.thickness_m(), 10.0 * params.contact_distance_m);
+  const double near_pad_m = params.contact_distance_m + params.skin_m;
+  model.near_sphere_centre_tool_m = tool.bounds_tool_m().center();
+  model.near_sphere_radius_m = 0.5 * (tool.bounds_tool_m().sizes() + Eigen::Vector3d::Constant(2.0 * near_pad_m)).norm();
   model.rim_plane.assign(tool.planes().size(), 0);
   for (int i = 0; i < tool.node_count(); ++i)
     if (tool.edge_node_flags()[static_cast<std::size_t>(i)] != 0)

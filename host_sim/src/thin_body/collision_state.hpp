@@ -67,6 +67,10 @@ struct CollisionModel {
   ThinBodyCollisionParams params;
   bool paired = true;          // false: the ray-only variant
   double memory_depth_m = 0.0; // how far behind a triangle a node already in contact may start
+  // The tool bounds padded by contact_distance + skin, as a sphere (tool frame): the broad
+  // phase's first, out-of-contact test (broad_phase_out_of_reach) reads only these.
+  Eigen::Vector3d near_sphere_centre_tool_m = Eigen::Vector3d::Zero();
+  double near_sphere_radius_m = 0.0;
   // Per tool plane: 1 when edge (rim) nodes lie on it (ToolNodes::edge_node_flags). A soft
   // triangle placed on a rim plane takes ALL its free vertices onto that plane whenever the move
   // does not pass through the tool (enforced_displacement.cpp).
