@@ -438,6 +438,16 @@ void prefetch_kept_faces(const CollisionModel& model, const CollisionData& data)
   }
 }
 
+// What a broad phase that found nothing leaves: no candidates, no work counted.
+void clear_step_results(CollisionData& data) {
+  data.candidate_nodes.clear();
+  data.candidate_faces.clear();
+  data.broad_nodes_scanned = 0;
+  data.broad_seed_nodes = 0;
+  data.broad_faces_tested = 0;
+  data.broad_faces_transformed = 0;
+}
+
 }  // namespace
 
 bool broad_phase_out_of_reach(const CollisionModel& model, const ToolPose& previous, const ToolPose& current,
@@ -459,12 +469,7 @@ bool broad_phase_out_of_reach(const CollisionModel& model, const ToolPose& previ
   Eigen::AlignedBox3d box(centre_prev);
   box.extend(centre_cur);
   if (body_meets(*node_bounds, grown(box, radius_m + slack_m))) return false;
-  data.candidate_nodes.clear();
-  data.candidate_faces.clear();
-  data.broad_nodes_scanned = 0;
-  data.broad_seed_nodes = 0;
-  data.broad_faces_tested = 0;
-  data.broad_faces_transformed = 0;
+  clear_step_results(data);
   return true;
 }
 
@@ -480,12 +485,7 @@ bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSo
     data.broad_faces_kept.reserve(static_cast<std::size_t>(model.soft.face_count));
   }
   data.candidate_nodes.swap(data.broad_previous_candidates);
-  data.candidate_nodes.clear();
-  data.candidate_faces.clear();
-  data.broad_nodes_scanned = 0;
-  data.broad_seed_nodes = 0;
-  data.broad_faces_tested = 0;
-  data.broad_faces_transformed = 0;
+  clear_step_results(data);
   data.broad_faces_kept.clear();
 
   const Query query = make_query(model, frame, data);
