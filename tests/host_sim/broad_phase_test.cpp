@@ -121,6 +121,25 @@ void expect_reached_faces_decided_exactly(const thin_body::CollisionData& data, 
   EXPECT_EQ(wrong, 0) << where << ": " << wrong << " reached faces decided unlike the exact test, first " << first;
 }
 
+// The node bounds NodeBoundsSolver leaves after a solve (every node's m_q and m_x, per block),
+// taken by brute force from the body as it is now.
+SoftNodeBounds bounds_as_the_solver_leaves_them(const btSoftBody& soft) {
+  SoftNodeBounds bounds;
+  bounds.node_count = soft.m_nodes.size();
+  const int blocks = (bounds.node_count + SoftNodeBounds::kNodesPerBlock - 1) / SoftNodeBounds::kNodesPerBlock;
+  const btVector3 large(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT);
+  bounds.block_lo.assign(static_cast<std::size_t>(blocks), large);
+  bounds.block_hi.assign(static_cast<std::size_t>(blocks), -large);
+  bounds.all_lo = large;
+  bounds.all_hi = -large;
+  for (int i = 0; i < soft.m_nodes.size(); ++i) {
+    bounds.extend(i, soft.m_nodes[i].m_q);
+    bounds.extend(i, soft.m_nodes[i].m_x);
+  }
+  bounds.valid = true;
+  return bounds;
+}
+
 struct Harness {
   test_scene::SoftWorld world{true};
   ToolNodes tool;
@@ -175,20 +194,7 @@ struct Harness {
 
   std::set<int> candidate_faces() const { return {data.candidate_faces.begin(), data.candidate_faces.end()}; }
 
-  void take_bounds() {
-    const btSoftBody& soft = world.soft();
-    const int blocks = (soft.m_nodes.size() + SoftNodeBounds::kNodesPerBlock - 1) / SoftNodeBounds::kNodesPerBlock;
-    bounds.node_count = soft.m_nodes.size();
-    bounds.block_lo.assign(static_cast<std::size_t>(blocks), btVector3(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT));
-    bounds.block_hi.assign(static_cast<std::size_t>(blocks), -btVector3(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT));
-    bounds.all_lo = bounds.block_lo[0];
-    bounds.all_hi = bounds.block_hi[0];
-    for (int i = 0; i < soft.m_nodes.size(); ++i) {
-      bounds.extend(i, soft.m_nodes[i].m_q);
-      bounds.extend(i, soft.m_nodes[i].m_x);
-    }
-    bounds.valid = true;
-  }
+  void take_bounds() { bounds = bounds_as_the_solver_leaves_them(world.soft()); }
 };
 
 void expect_candidate_nodes_are_the_vertices(Harness& h, const thin_body::StepFrame& frame) {
@@ -454,20 +460,7 @@ TEST(BroadPhase, NodesMovedByAnotherPartAfterTheBoundsWereTakenAreFound) {
     thin_body::allocate_collision_data(model_a, data_a);
     thin_body::allocate_collision_data(model_b, data_b);
     world.step_without_dynamics();
-    SoftNodeBounds bounds;
-    const btSoftBody& soft = world.soft();
-    bounds.node_count = soft.m_nodes.size();
-    const int blocks = (bounds.node_count + SoftNodeBounds::kNodesPerBlock - 1) / SoftNodeBounds::kNodesPerBlock;
-    const btVector3 large(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT);
-    bounds.block_lo.assign(static_cast<std::size_t>(blocks), large);
-    bounds.block_hi.assign(static_cast<std::size_t>(blocks), -large);
-    bounds.all_lo = large;
-    bounds.all_hi = -large;
-    for (int i = 0; i < soft.m_nodes.size(); ++i) {
-      bounds.extend(i, soft.m_nodes[i].m_q);
-      bounds.extend(i, soft.m_nodes[i].m_x);
-    }
-    bounds.valid = true;
+    SoftNodeBounds bounds = bounds_as_the_solver_leaves_them(world.soft());
     SoftNodeBounds* shared = with_bounds ? &bounds : nullptr;
     ToolPose a_from, a_to, b_pose;
     a_from.position_world_m = Eigen::Vector3d(0, 0.003, 0);

@@ -159,8 +159,7 @@ double rotation_slack_m(const CollisionModel& model, const StepFrame& frame, dou
 // bench collision's 20 480-face same contact, 247 seeds for 24 candidate faces) is not read.
 // Which side: the one the body's rest bounds extend furthest beyond Q (any choice is exact; this
 // one is the same on every path, whatever the current positions).
-Eigen::AlignedBox3d seed_box(const CollisionModel& model, const Eigen::AlignedBox3d& swept_world_box, const Eigen::AlignedBox3d& grown_world) {
-  const Eigen::AlignedBox3d& faces_world = swept_world_box;
+Eigen::AlignedBox3d seed_box(const CollisionModel& model, const Eigen::AlignedBox3d& query_world, const Eigen::AlignedBox3d& grown_world) {
   Eigen::AlignedBox3d seed = grown_world;
   const Eigen::AlignedBox3d& body = model.soft.rest_bounds_world_m;
   if (body.isEmpty()) return seed;
@@ -168,16 +167,16 @@ Eigen::AlignedBox3d seed_box(const CollisionModel& model, const Eigen::AlignedBo
   bool best_below = false;
   double best_m = 0.0;
   for (int k = 0; k < 3; ++k) {
-    const double below_m = faces_world.min()[k] - body.min()[k];
-    const double above_m = body.max()[k] - faces_world.max()[k];
+    const double below_m = query_world.min()[k] - body.min()[k];
+    const double above_m = body.max()[k] - query_world.max()[k];
     if (below_m > best_m) best_m = below_m, best_axis = k, best_below = true;
     if (above_m > best_m) best_m = above_m, best_axis = k, best_below = false;
   }
   if (best_axis < 0) return seed;
   if (best_below) {
-    seed.min()[best_axis] = std::min(seed.max()[best_axis], faces_world.min()[best_axis]);
+    seed.min()[best_axis] = std::min(seed.max()[best_axis], query_world.min()[best_axis]);
   } else {
-    seed.max()[best_axis] = std::max(seed.min()[best_axis], faces_world.max()[best_axis]);
+    seed.max()[best_axis] = std::max(seed.min()[best_axis], query_world.max()[best_axis]);
   }
   return seed;
 }
