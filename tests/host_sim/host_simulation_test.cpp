@@ -29,11 +29,14 @@ struct RunSummary {
   bool finite = true;
   double force_max_n = 0.0;
   std::vector<double> force_y;
+  std::vector<double> jaw_gap_m;            // per step (clamp: the gap applied)
+  std::vector<double> larger_part_force_n;  // per step: the larger part's (jaw's) |F|
 };
 
-RunSummary run_scripted(const SceneDescription& scene, std::optional<SceneCollisionMethod> method = std::nullopt) {
+RunSummary run_scripted(const SceneDescription& scene, std::optional<SceneCollisionMethod> method = std::nullopt,
+                        double settle_s = 0.3) {
   HostSimulation sim(scene, method);
-  sim.settle(0.3);
+  sim.settle(settle_s);
   RunSummary out;
   const long steps = std::lround(trajectory_duration_s(scene) / scene.simulation.time_step_s);
   for (long i = 0; i < steps; ++i) {
@@ -44,6 +47,8 @@ RunSummary run_scripted(const SceneDescription& scene, std::optional<SceneCollis
     out.finite = out.finite && r.force_on_tool_world_n.allFinite();
     out.force_max_n = std::max(out.force_max_n, r.force_on_tool_world_n.norm());
     out.force_y.push_back(r.force_on_tool_world_n.y());
+    out.jaw_gap_m.push_back(r.jaw_gap_m);
+    out.larger_part_force_n.push_back(std::max(r.part_force_world_n[0].norm(), r.part_force_world_n[1].norm()));
   }
   return out;
 }
@@ -366,17 +371,13 @@ struct ClampOpening {
 
 ClampOpening run_clamp_script(double settle_s) {
   const SceneDescription scene = load_scene(resolve_scene_path("clamp-sphere"));
-  HostSimulation sim(scene);
-  sim.settle(settle_s);
-  const long steps = std::lround(trajectory_duration_s(scene) / scene.simulation.time_step_s);
+  const RunSummary run = run_scripted(scene, std::nullopt, settle_s);
   ClampOpening result;
-  for (long i = 0; i < steps; ++i) {
-    const TrajectorySample target = sim.scripted_target();
-    const HostStepResult& r = sim.step(to_tool_pose(target.pose), target.jaw_gap_m);
-    const double f = std::max(r.part_force_world_n[0].norm(), r.part_force_world_n[1].norm());
+  for (std::size_t i = 0; i < run.jaw_gap_m.size(); ++i) {
+    const double f = run.larger_part_force_n[i];
     result.script_max_n = std::max(result.script_max_n, f);
     // Fully open for 5 ms: the release must be over.
-    if (r.jaw_gap_m >= scene.tool.clamp.jaw_gap_open_m - 1e-9 && ++result.open_steps > 5)
+    if (run.jaw_gap_m[i] >= scene.tool.clamp.jaw_gap_open_m - 1e-9 && ++result.open_steps > 5)
       result.open_force_max_n = std::max(result.open_force_max_n, f);
   }
   return result;
