@@ -82,6 +82,47 @@ double ToolVolume::signed_distance_m(const Eigen::Vector3d& p_tool) const noexce
   return d;
 }
 
+bool ToolVolume::reaches_inside(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, double depth_tolerance_m,
+                                std::vector<Eigen::Vector3d>& scratch) const {
+  // The polygon left after each clip is kept in the first half of `scratch`, the next one is
+  // built in the second half; a convex polygon clipped by a plane gains at most one vertex.
+  const std::size_t capacity = 3 + planes_.size();
+  scratch.resize(2 * capacity);
+  std::size_t count = 3;
+  scratch[0] = a;
+  scratch[1] = b;
+  scratch[2] = c;
+  for (const Plane& plane : planes_) {
+    const double offset = plane.offset_m - depth_tolerance_m;
+    std::size_t next = 0;
+    for (std::size_t k = 0; k < count; ++k) {
+      const Eigen::Vector3d& p = scratch[k];
+      const Eigen::Vector3d& q = scratch[(k + 1) % count];
+      const double fp = plane.normal.dot(p) - offset;  // < 0: inside
+      const double fq = plane.normal.dot(q) - offset;
+      if (fp < 0.0) scratch[capacity + next++] = p;
+      if ((fp < 0.0) != (fq < 0.0)) scratch[capacity + next++] = p + (fp / (fp - fq)) * (q - p);
+    }
+    if (next == 0) return false;
+    for (std::size_t k = 0; k < next; ++k) scratch[k] = scratch[capacity + k];
+    count = next;
+  }
+  return true;
+}
+
+int triangles_cut_by_volume(const ToolVolume& volume, const std::vector<Eigen::Vector3d>& soft_nodes_world_m,
+                            const std::vector<std::array<int, 3>>& faces, const Eigen::Isometry3d& tool_to_world,
+                            double depth_tolerance_m) {
+  const Eigen::Isometry3d world_to_tool = tool_to_world.inverse();
+  std::vector<Eigen::Vector3d> scratch;
+  int cut = 0;
+  for (const std::array<int, 3>& face : faces) {
+    const auto corner = [&](std::size_t k) { return Eigen::Vector3d(world_to_tool * soft_nodes_world_m[static_cast<std::size_t>(face[k])]); };
+    if (volume.reaches_inside(corner(0), corner(1), corner(2), depth_tolerance_m, scratch)) ++cut;
+  }
+  return cut;
+}
+
 bool ToolVolume::in_footprint(const Eigen::Vector3d& p_tool) const noexcept {
   const Eigen::Vector2d q(p_tool.x(), p_tool.z());
   for (const Edge2d& e : footprint_) {

@@ -116,6 +116,19 @@ Eigen::AlignedBox3d HostSimulation::soft_bounds_world_m() const noexcept {
 }
 
 int HostSimulation::soft_face_count() const noexcept { return world_->soft().m_faces.size(); }
+int HostSimulation::triangles_cut_by_tool(double depth_tolerance_m) const {
+  const btSoftBody& soft = world_->soft();
+  std::vector<std::array<int, 3>> faces(static_cast<std::size_t>(soft.m_faces.size()));
+  for (int f = 0; f < soft.m_faces.size(); ++f)
+    for (int k = 0; k < 3; ++k) faces[static_cast<std::size_t>(f)][static_cast<std::size_t>(k)] = static_cast<int>(soft.m_faces[f].m_n[k] - &soft.m_nodes[0]);
+  int cut = 0;
+  for (int p = 0; p < world_->part_count(); ++p) {
+    const auto k = static_cast<std::size_t>(p);
+    cut += triangles_cut_by_volume(trackers_[k].volume(), nodes_, faces, to_isometry(part_poses_[k]), depth_tolerance_m);
+  }
+  return cut;
+}
+
 int HostSimulation::soft_node_count() const noexcept { return world_->soft().m_nodes.size(); }
 
 TrajectorySample HostSimulation::scripted_target() const noexcept { return sample_trajectory(scene_, time_s_ + scene_.simulation.time_step_s); }

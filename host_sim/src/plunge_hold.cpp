@@ -69,7 +69,7 @@ HoldForceStats hold_force_stats(const std::vector<double>& force_n) {
 }
 
 PlungeHoldResult run_plunge_hold(const SceneDescription& scene, SceneCollisionMethod method, double speed_m_s, double leading_half_m,
-                                 double hold_s) {
+                                 double hold_s, bool count_cut_triangles) {
   HostSimulation sim(scene, method);
   const double dt = scene.simulation.time_step_s;
   // Start well clear, settle, then find the soft surface's top.
@@ -110,6 +110,7 @@ PlungeHoldResult run_plunge_hold(const SceneDescription& scene, SceneCollisionMe
   const long hold_steps = std::lround(hold_s / dt);
   result.hold_force_n.reserve(static_cast<std::size_t>(hold_steps));
   int previous_triangles = -1;
+  if (count_cut_triangles) result.hold_max_cut_triangles = result.hold_steps_with_cut_triangles = 0;
   for (long i = 0; i < settle_steps + hold_steps; ++i) {
     const HostStepResult& r = sim.step(pose);
     record(r);
@@ -119,6 +120,11 @@ PlungeHoldResult run_plunge_hold(const SceneDescription& scene, SceneCollisionMe
     if (i == settle_steps) result.ball_centre_hold_start_world_m = ball_centre();
     else if (triangles != previous_triangles) ++result.hold_contact_set_changes;
     previous_triangles = triangles;
+    if (count_cut_triangles) {
+      const int cut = sim.triangles_cut_by_tool(kInsideToleranceM);
+      result.hold_max_cut_triangles = std::max(result.hold_max_cut_triangles, cut);
+      if (cut > 0) ++result.hold_steps_with_cut_triangles;
+    }
   }
   result.ball_centre_hold_end_world_m = ball_centre();
   result.hold = hold_force_stats(result.hold_force_n);

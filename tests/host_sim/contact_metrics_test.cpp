@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <random>
+#include <vector>
 
 namespace fissure::host {
 namespace {
@@ -46,6 +48,41 @@ TEST(ToolVolume, ConvexMeshOfABoxAgreesWithTheBox) {
     EXPECT_EQ(mesh.in_footprint(p), box.in_footprint(p));
   }
   EXPECT_NEAR(mesh.half_thickness_m(), 0.002, 1e-15);
+}
+
+// A 1 mm blade slicing a coarse triangle between its vertices: every vertex is 10 mm outside,
+// the triangle's middle is 0.5 mm deep (the half thickness). A 12-per-edge sample grid (1.7 mm
+// apart on this 20 mm triangle) can fall either side of the blade; the clip cannot.
+TEST(ToolVolume, ReachesInsideFindsATriangleSlicedBetweenItsVertices) {
+  const ToolVolume blade = ToolVolume::from_box({0.05, 0.0005, 0.05});
+  std::vector<Eigen::Vector3d> scratch;
+  const Eigen::Vector3d a(-0.01, -0.01, 0.0), b(0.01, -0.01, 0.0), c(0.0, 0.01, 0.0);
+  for (const Eigen::Vector3d& v : {a, b, c}) EXPECT_GT(blade.signed_distance_m(v), 0.009);
+  EXPECT_TRUE(blade.reaches_inside(a, b, c, 1e-4, scratch));
+  EXPECT_TRUE(blade.reaches_inside(a, b, c, 4.9e-4, scratch));   // just under the 0.5 mm it reaches
+  EXPECT_FALSE(blade.reaches_inside(a, b, c, 5.1e-4, scratch));  // just over
+  // Beside the blade (x beyond its 50 mm half length), or above it: not cut.
+  const Eigen::Vector3d beside(0.07, 0.0, 0.0);
+  EXPECT_FALSE(blade.reaches_inside(a + beside, b + beside, c + beside, 1e-4, scratch));
+  const Eigen::Vector3d above(0.0, 0.0106, 0.0);
+  EXPECT_FALSE(blade.reaches_inside(a + above, b + above, c + above, 1e-4, scratch));
+  // A triangle lying flat in the blade's mid-plane is inside over its whole area.
+  EXPECT_TRUE(blade.reaches_inside({-0.01, 0, -0.01}, {0.01, 0, -0.01}, {0, 0, 0.01}, 1e-4, scratch));
+}
+
+TEST(ToolVolume, TrianglesCutCountsOnlyTheSlicedOnesInTheToolsOwnFrame) {
+  const ToolVolume blade = ToolVolume::from_box({0.05, 0.0005, 0.05});
+  // The tool at x = 1 m, turned 90° about z: its thin axis is world x.
+  Eigen::Isometry3d tool_to_world = at(1.0, 0.0, 0.0);
+  tool_to_world.rotate(Eigen::AngleAxisd(0.5 * 3.14159265358979323846, Eigen::Vector3d::UnitZ()));
+  const std::vector<Eigen::Vector3d> nodes = {
+      {0.99, -0.01, 0.0}, {1.01, -0.01, 0.0}, {1.0, 0.01, 0.0},    // spans world x across the blade: cut
+      {0.99, 0.02, 0.0},  {0.99, 0.04, 0.0},  {0.99, 0.03, 0.01},  // 10 mm to its side: not
+  };
+  const std::vector<std::array<int, 3>> faces = {{0, 1, 2}, {3, 4, 5}};
+  EXPECT_EQ(triangles_cut_by_volume(blade, nodes, faces, tool_to_world, 1e-4), 1);
+  EXPECT_EQ(triangles_cut_by_volume(blade, nodes, faces, at(1.0, 0.0, 0.0), 1e-4), 1);  // unturned: the first still spans y
+  EXPECT_EQ(triangles_cut_by_volume(blade, nodes, faces, at(1.2, 0.0, 0.0), 1e-4), 0);  // moved away
 }
 
 TEST(CrossingTracker, NodePushedThroughThePlateIsCrossed) {

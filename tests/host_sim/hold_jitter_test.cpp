@@ -28,15 +28,17 @@ TEST_P(PairedSweepHold, NoCrossingNoPenetrationAndContactAtEverySpeed) {
   const PlungeTool& tool = plunge_tools()[static_cast<std::size_t>(GetParam())];
   const SceneDescription scene = plunge_scene(tool);
   for (const double speed : kSpeedsMS) {
-    const PlungeHoldResult c = run_plunge_hold(scene, SceneCollisionMethod::kPaired, speed, tool.leading_half_m, kHoldS);
-    // The diagnosis beside the figure: does the contact set change, and does the ball move?
+    const PlungeHoldResult c = run_plunge_hold(scene, SceneCollisionMethod::kPaired, speed, tool.leading_half_m, kHoldS, true);
+    // The diagnosis beside the figure: does the contact set change, does the ball move, and are
+    // soft triangles cut by the tool with no node inside it (the crossed count cannot see those)?
     const int set_changes = c.hold_contact_set_changes;
     const Vec3& a = c.ball_centre_hold_start_world_m;
     const Vec3& b = c.ball_centre_hold_end_world_m;
     std::printf("%-17s %5.1f m/s: crossed %d, penetration %.4f mm, F_hold %.3f N, jitter %.3f %% | contact-set changes %d, "
-                "ball centre moved (%.1f, %.1f) mm in x, z over the hold\n",
+                "ball centre moved (%.1f, %.1f) mm in x, z over the hold | cut triangles max %d, on %d of %zu hold steps\n",
                 std::string(tool.name).c_str(), speed, c.crossed_nodes, c.max_penetration_m * 1e3, c.hold.mean_n, 100.0 * c.hold.jitter,
-                set_changes, (b[0] - a[0]) * 1e3, (b[2] - a[2]) * 1e3);
+                set_changes, (b[0] - a[0]) * 1e3, (b[2] - a[2]) * 1e3, c.hold_max_cut_triangles, c.hold_steps_with_cut_triangles,
+                c.hold_force_n.size());
     EXPECT_EQ(c.crossed_nodes, 0) << tool.name << " at " << speed << " m/s";
     EXPECT_LE(c.max_penetration_m, kMaxPenetrationM) << tool.name << " at " << speed << " m/s";
     EXPECT_GT(c.hold.mean_n, 0.0) << tool.name << " at " << speed << " m/s: the held tool lost the ball";
@@ -45,8 +47,10 @@ TEST_P(PairedSweepHold, NoCrossingNoPenetrationAndContactAtEverySpeed) {
 
 // The hold-jitter target, ≤ 1 % in every cell. NOT MET (disabled so that it stays
 // visible; run with --gtest_also_run_disabled_tests): 13 of the 32 cells are within 1 %; the
-// diagnosis beside each cell (contact-set changes, ball centre motion over the hold) is printed
-// by the test above.
+// diagnosis beside each cell (contact-set changes, ball centre motion, triangles cut by the tool
+// over the hold) is printed by the test above. Cut triangles and jitter do not map one to one:
+// the blade at 0.1 m/s chatters (12 %) with none cut; the convex spatula at 10 and 50 m/s holds
+// steady (0 %) with 3-5 cut on every step.
 TEST_P(PairedSweepHold, DISABLED_HoldJitterIsAtMostOnePercentAtEverySpeed) {
   const PlungeTool& tool = plunge_tools()[static_cast<std::size_t>(GetParam())];
   const SceneDescription scene = plunge_scene(tool);

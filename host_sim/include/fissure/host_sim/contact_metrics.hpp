@@ -50,6 +50,12 @@ class ToolVolume {
 
   /// max over planes of (n·p − d): exact depth (negative) inside, a lower bound outside.
   [[nodiscard]] double signed_distance_m(const Eigen::Vector3d& p_tool) const noexcept;
+  /// Whether some point of the triangle a, b, c (tool frame) lies deeper than depth_tolerance_m
+  /// inside (signed_distance_m < −tolerance): exact, by clipping the triangle against every plane
+  /// moved inward by the tolerance (Sutherland–Hodgman) — sampling would miss a 1 mm blade
+  /// between the samples of a 21 mm triangle. `scratch` is reused between calls.
+  [[nodiscard]] bool reaches_inside(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, double depth_tolerance_m,
+                                    std::vector<Eigen::Vector3d>& scratch) const;
   /// Whether p_tool's projection along y falls inside the tool's silhouette.
   [[nodiscard]] bool in_footprint(const Eigen::Vector3d& p_tool) const noexcept;
   [[nodiscard]] double half_thickness_m() const noexcept { return half_thickness_m_; }
@@ -67,6 +73,15 @@ class ToolVolume {
   std::vector<Edge2d> footprint_;
   double half_thickness_m_ = 0.0;
 };
+
+/// How many soft triangles (world node positions, index triples) reach deeper than
+/// depth_tolerance_m into the tool (ToolVolume::reaches_inside). A thin tool that slices a coarse
+/// triangle between its nodes leaves every node outside and the triangle's interior inside: the
+/// node-based crossed count cannot see that, this can. A diagnostic (faces × planes² work and a
+/// scratch allocation), not a per-step metric.
+[[nodiscard]] int triangles_cut_by_volume(const ToolVolume& volume, const std::vector<Eigen::Vector3d>& soft_nodes_world_m,
+                                          const std::vector<std::array<int, 3>>& faces, const Eigen::Isometry3d& tool_to_world,
+                                          double depth_tolerance_m);
 
 /// What the metrics saw after one step, for one tool part (a jaw, or the whole spatula).
 struct CrossingSnapshot {

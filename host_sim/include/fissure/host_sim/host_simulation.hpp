@@ -93,6 +93,10 @@ class HostSimulation {
   /// The collision model of part p (nullptr for the bullet method).
   [[nodiscard]] const ToolNodes* tool_nodes(int part) const noexcept;
   [[nodiscard]] int soft_face_count() const noexcept;
+  /// Soft triangles cut by the tool's interior now (triangles_cut_by_volume with the metrics'
+  /// tool volume, summed over the parts): the failure the crossed count cannot see. Diagnostic
+  /// cost; not part of step().
+  [[nodiscard]] int triangles_cut_by_tool(double depth_tolerance_m) const;
   [[nodiscard]] int soft_node_count() const noexcept;
   [[nodiscard]] const ToolPose& tool_pose() const noexcept { return tool_pose_; }
   /// Axis-aligned bounds of the soft nodes (world) as of the last step/settle.

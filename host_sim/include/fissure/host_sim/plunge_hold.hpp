@@ -71,13 +71,17 @@ struct PlungeHoldResult {
   int hold_contact_set_changes = 0;   ///< steps whose force-set triangle count differs from the step before's
   Vec3 ball_centre_hold_start_world_m{};  ///< mean of the soft nodes at the first hold step ...
   Vec3 ball_centre_hold_end_world_m{};    ///< ... and at the last
+  // Soft triangles cut by the tool's interior deeper than kInsideToleranceM (triangles_cut_by_tool)
+  // over the hold window; −1 unless asked for (count_cut_triangles: it costs more than the step).
+  int hold_max_cut_triangles = -1;        ///< the most on any hold step
+  int hold_steps_with_cut_triangles = -1; ///< hold steps with at least one
   std::vector<double> step_s;        ///< wall time of every step (plunge and hold)
   HoldForceStats hold;
 };
 
 /// Settles, plunges the tool kPlungeDepth_m into the ball at `speed_m_s`, holds it
-/// kHoldSettle_s + hold_s, and measures.
+/// kHoldSettle_s + hold_s, and measures (the cut triangles too when count_cut_triangles).
 [[nodiscard]] PlungeHoldResult run_plunge_hold(const SceneDescription& scene, SceneCollisionMethod method, double speed_m_s,
-                                               double leading_half_m, double hold_s);
+                                               double leading_half_m, double hold_s, bool count_cut_triangles = false);
 
 }  // namespace fissure::host
