@@ -160,14 +160,16 @@ nlohmann::json run_bench(const BenchOptions& o) {
     std::printf("(hold: |F| every step for %.1f s after a %.0f ms settling window, fitted by a line; in %% of the mean force:\n"
                 " jitter = residual std about the line, std = plain std, step = std of the step-to-step change / sqrt 2,\n"
                 " drift = the line's change over the hold (the soft body relaxing); 'lost' = no contact left in the hold)\n", hold_s, host::kHoldSettle_s * 1e3);
-    std::printf("%-17s %-7s %7s | %7s %7s %7s | %9s %8s %8s %8s %8s %9s %9s\n", "tool", "method", "v m/s", "crossed", "wrong", "inside", "pen mm",
-                "jitter%", "std%", "step%", "drift%", "F_hold N", "med us");
+    std::printf(" cut = soft triangles reaching > %.1f mm into the tool during the hold, most on a step / steps with any (nodes may all be outside))\n",
+                host::kInsideToleranceM * 1e3);
+    std::printf("%-17s %-7s %7s | %7s %7s %7s | %9s %8s %8s %8s %8s %9s %9s %9s\n", "tool", "method", "v m/s", "crossed", "wrong", "inside", "pen mm",
+                "jitter%", "std%", "step%", "drift%", "F_hold N", "med us", "cut");
     for (const host::PlungeTool& tool : tools) {
       const SceneDescription scene = host::plunge_scene(tool);
       const std::string tool_name(tool.name);
       for (SceneCollisionMethod method : methods) {
         for (double v : speeds) {
-          const host::PlungeHoldResult c = host::run_plunge_hold(scene, method, v, tool.leading_half_m, hold_s);
+          const host::PlungeHoldResult c = host::run_plunge_hold(scene, method, v, tool.leading_half_m, hold_s, /*count_cut_triangles=*/true);
           const host::HoldForceStats& h = c.hold;
           const double median_us = sim_quantile(c.step_s, 0.5) * 1e6;
           const double p99_us = sim_quantile(c.step_s, 0.99) * 1e6;
@@ -179,15 +181,17 @@ nlohmann::json run_bench(const BenchOptions& o) {
             std::snprintf(step_noise, sizeof step_noise, "%.3f", 100.0 * h.step_noise);
             std::snprintf(drift, sizeof drift, "%+.2f", 100.0 * h.drift);
           }
-          std::printf("\r%-17s %-7s %7.1f | %7d %7d %7d | %9.3f %8s %8s %8s %8s %9.3f %9.1f\033[K\n", tool_name.c_str(), host::to_string(method), v,
-                      c.crossed_nodes, c.wrong_side_nodes, c.inside_nodes, c.max_penetration_m * 1e3, jitter, std_over_mean, step_noise, drift, h.mean_n,
-                      median_us);
+          std::printf("\r%-17s %-7s %7.1f | %7d %7d %7d | %9.3f %8s %8s %8s %8s %9.3f %9.1f %4d/%-4d\033[K\n", tool_name.c_str(),
+                      host::to_string(method), v, c.crossed_nodes, c.wrong_side_nodes, c.inside_nodes, c.max_penetration_m * 1e3, jitter, std_over_mean,
+                      step_noise, drift, h.mean_n, median_us, c.hold_max_cut_triangles, c.hold_steps_with_cut_triangles);
           const auto if_contact = [&](double x) { return h.in_contact ? nlohmann::json(x) : nlohmann::json(nullptr); };
           sweep.push_back({{"method", host::to_string(method)}, {"tool", tool_name}, {"speed_m_s", v}, {"crossed_nodes", c.crossed_nodes},
                            {"wrong_side_nodes", c.wrong_side_nodes}, {"inside_nodes", c.inside_nodes}, {"max_penetration_m", c.max_penetration_m},
                            {"force_jitter", if_contact(h.jitter)}, {"force_std_over_mean", if_contact(h.std_over_mean)},
                            {"force_step_noise", if_contact(h.step_noise)}, {"force_drift", if_contact(h.drift)}, {"hold_in_contact", h.in_contact},
-                           {"hold_settle_s", host::kHoldSettle_s}, {"hold_force_n", h.mean_n}, {"step_median_us", median_us}, {"step_p99_us", p99_us}});
+                           {"hold_settle_s", host::kHoldSettle_s}, {"hold_force_n", h.mean_n}, {"step_median_us", median_us}, {"step_p99_us", p99_us},
+                           {"hold_steps", c.hold_force_n.size()}, {"hold_max_cut_triangles", c.hold_max_cut_triangles},
+                           {"hold_steps_with_cut_triangles", c.hold_steps_with_cut_triangles}});
         }
       }
     }

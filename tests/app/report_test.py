@@ -126,6 +126,10 @@ def main():
             if row is not None:
                 check(row[4] == status, f"target '{description}': status '{row[4]}', expected '{status}'")
         check("**FAILED**: exit 1" in report, "the failed view child is not reported as FAILED")
+        # The sweep's cut-triangle table: most on one step / steps with any (fixture: bullet 1 / 7).
+        check("Soft triangles cut by the tool during the hold" in report and "of 100." in report, "no cut-triangle table")
+        check(any(line.startswith("| plate_4mm | bullet | 1 / 7 |") for line in report.splitlines()) and
+              any(line.startswith("| plate_4mm | paired | 0 / 0 |") for line in report.splitlines()), "cut-triangle cells wrong")
 
         # The full stress profile (bench all --stress-full): its own summary and target. The
         # fixture's ci rows relabelled as a full run: its failing case must fail the target.

@@ -455,6 +455,22 @@ def section_tunnelling(report, data, problems, targets):
                                    f"{100 * (cell[(t, 'paired', v)].get('force_drift') or 0):+.1f}%")
                              if (t, "paired", v) in cell else "—" for v in speeds]
                       for t in tools if any(r["tool"] == t for r in jitter_rows)]))
+    if any("hold_max_cut_triangles" in r for r in sweep):
+        steps = next((r.get("hold_steps") for r in sweep if r.get("hold_steps")), "?")
+        report.add("Soft triangles cut by the tool during the hold: reaching more than 0.1 mm into its volume, most on one step / "
+                   f"steps with any, of {steps}. The penetration above is measured at the nodes; a coarse triangle can pass "
+                   "into a thin tool between its nodes, which only this count shows.")
+        report.add("")
+        cut_rows = []
+        for t in tools:
+            for m in methods:
+                cells = []
+                for v in speeds:
+                    r = cell.get((t, m, v))
+                    cells.append("—" if r is None or r.get("hold_max_cut_triangles") is None else
+                                 f"{r['hold_max_cut_triangles']} / {r['hold_steps_with_cut_triangles']}")
+                cut_rows.append([t, m] + cells)
+        report.add(table(["tool", "method"] + [f"{v:g} m/s" for v in speeds], cut_rows))
     report.add(targets_table([t for t in targets if t.section == "collision sweep"]))
 
     report.add("### Force–indentation and mesh convergence")
