@@ -435,16 +435,17 @@ def section_tunnelling(report, data, problems, targets):
                "soft-rigid collision set up fairly (fine voxel, mm margin, kKHR 1); `ray` is the paper's rays without "
                "pairing; `paired` is ours.")
     report.add("")
-    rows = []
-    for t in tools:
-        for m in methods:
-            cells = []
-            for v in speeds:
-                r = cell.get((t, m, v))
-                cells.append("—" if r is None else
-                             f"{r['crossed_nodes']}/{r['max_penetration_m'] * 1e3:.2f}/{r['step_median_us']:.0f}")
-            rows.append([t, m] + cells)
-    report.add(table(["tool", "method"] + [f"{v:g} m/s" for v in speeds], rows))
+    def tool_method_table(cell_text_of):
+        # One row per tool and method, one column per speed; cell_text_of(row) gives the text, or
+        # None for "—" (as does a missing cell).
+        rows = []
+        for t in tools:
+            for m in methods:
+                texts = [None if cell.get((t, m, v)) is None else cell_text_of(cell[(t, m, v)]) for v in speeds]
+                rows.append([t, m] + ["—" if x is None else x for x in texts])
+        return table(["tool", "method"] + [f"{v:g} m/s" for v in speeds], rows)
+
+    report.add(tool_method_table(lambda r: f"{r['crossed_nodes']}/{r['max_penetration_m'] * 1e3:.2f}/{r['step_median_us']:.0f}"))
     jitter_rows = [r for r in sweep if r["method"] == "paired"]
     report.add("Hold after the plunge (paired): force jitter (residual std / mean about a fitted line) and drift; "
                "`lost` = no contact left in the hold.")
@@ -461,16 +462,8 @@ def section_tunnelling(report, data, problems, targets):
                    f"steps with any, of {steps}. The penetration above is measured at the nodes; a coarse triangle can pass "
                    "into a thin tool between its nodes, which only this count shows.")
         report.add("")
-        cut_rows = []
-        for t in tools:
-            for m in methods:
-                cells = []
-                for v in speeds:
-                    r = cell.get((t, m, v))
-                    cells.append("—" if r is None or r.get("hold_max_cut_triangles") is None else
-                                 f"{r['hold_max_cut_triangles']} / {r['hold_steps_with_cut_triangles']}")
-                cut_rows.append([t, m] + cells)
-        report.add(table(["tool", "method"] + [f"{v:g} m/s" for v in speeds], cut_rows))
+        report.add(tool_method_table(lambda r: None if r.get("hold_max_cut_triangles") is None else
+                                     f"{r['hold_max_cut_triangles']} / {r['hold_steps_with_cut_triangles']}"))
     report.add(targets_table([t for t in targets if t.section == "collision sweep"]))
 
     report.add("### Force–indentation and mesh convergence")
