@@ -95,6 +95,10 @@ HostSimulation::HostSimulation(const SceneDescription& scene, std::optional<Scen
   }
   const ToolVolume volume = build_volume(scene_);
   for (int p = 0; p < parts; ++p) trackers_.emplace_back(volume, soft.m_nodes.size());
+  soft_faces_.resize(static_cast<std::size_t>(soft.m_faces.size()));
+  for (int f = 0; f < soft.m_faces.size(); ++f)
+    for (int k = 0; k < 3; ++k)
+      soft_faces_[static_cast<std::size_t>(f)][static_cast<std::size_t>(k)] = static_cast<int>(soft.m_faces[f].m_n[k] - &soft.m_nodes[0]);
   result_.part_count = parts;
   result_.contacts.reserve(static_cast<std::size_t>(parts * std::max(soft.m_faces.size(), soft.m_nodes.size())));
   for (auto& r : result_.part_results) r.reserve_for(std::max(soft.m_faces.size(), soft.m_nodes.size()));
@@ -117,14 +121,10 @@ Eigen::AlignedBox3d HostSimulation::soft_bounds_world_m() const noexcept {
 
 int HostSimulation::soft_face_count() const noexcept { return world_->soft().m_faces.size(); }
 int HostSimulation::triangles_cut_by_tool(double depth_tolerance_m) const {
-  const btSoftBody& soft = world_->soft();
-  std::vector<std::array<int, 3>> faces(static_cast<std::size_t>(soft.m_faces.size()));
-  for (int f = 0; f < soft.m_faces.size(); ++f)
-    for (int k = 0; k < 3; ++k) faces[static_cast<std::size_t>(f)][static_cast<std::size_t>(k)] = static_cast<int>(soft.m_faces[f].m_n[k] - &soft.m_nodes[0]);
   int cut = 0;
   for (int p = 0; p < world_->part_count(); ++p) {
     const auto k = static_cast<std::size_t>(p);
-    cut += triangles_cut_by_volume(trackers_[k].volume(), nodes_, faces, to_isometry(part_poses_[k]), depth_tolerance_m);
+    cut += triangles_cut_by_volume(trackers_[k].volume(), nodes_, soft_faces_, to_isometry(part_poses_[k]), depth_tolerance_m);
   }
   return cut;
 }

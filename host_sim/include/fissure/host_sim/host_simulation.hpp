@@ -111,6 +111,7 @@ class HostSimulation {
   std::vector<ToolNodes> tool_nodes_;  // per part (paired/ray)
   std::array<std::unique_ptr<ThinBodyCollision>, kMaxToolParts> collisions_;
   std::vector<CrossingTracker> trackers_;
+  std::vector<std::array<int, 3>> soft_faces_;  // node indices of each soft face (fixed topology; triangles_cut_by_tool)
   std::vector<Eigen::Vector3d> nodes_;
   ToolPose tool_pose_;
   double jaw_gap_m_ = 0.0;

@@ -72,7 +72,7 @@ struct PlungeHoldResult {
   Vec3 ball_centre_hold_start_world_m{};  ///< mean of the soft nodes at the first hold step ...
   Vec3 ball_centre_hold_end_world_m{};    ///< ... and at the last
   // Soft triangles cut by the tool's interior deeper than kInsideToleranceM (triangles_cut_by_tool)
-  // over the hold window; −1 unless asked for (count_cut_triangles: it costs more than the step).
+  // over the hold window; −1 unless asked for (count_cut_triangles: it reads every face each step).
   int hold_max_cut_triangles = -1;        ///< the most on any hold step
   int hold_steps_with_cut_triangles = -1; ///< hold steps with at least one
   std::vector<double> step_s;        ///< wall time of every step (plunge and hold)
