@@ -32,10 +32,11 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include "machine_info.hpp"
-#include "shell_quote.hpp"
+#include "fissure/session/machine_info.hpp"
+#include "fissure/session/shell_quote.hpp"
 
 namespace fissure::app {
+using namespace fissure::session;  // the session library: SessionHost, run_session, LinkBridge, …
 namespace {
 
 namespace fs = std::filesystem;

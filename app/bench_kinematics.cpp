@@ -10,7 +10,7 @@
 // read costs ~20–40 ns on this VM, more than a third of an IK), time per solve = batch
 // time / 64; median and p99 are over batches pooled from all repeats.
 #include "bench_kinematics.hpp"
-#include "machine_info.hpp"
+#include "fissure/session/machine_info.hpp"
 
 #include <sys/utsname.h>
 
@@ -38,6 +38,7 @@
 #include "fissure/falcon_hw/motor_command.hpp"
 
 namespace fissure::app {
+using namespace fissure::session;  // the session library: SessionHost, run_session, LinkBridge, …
 namespace {
 
 using falcon::FalconGeometry;

@@ -32,10 +32,11 @@
 #include "fissure/host_sim/host_simulation.hpp"
 #include "fissure/host_sim/scene_loader.hpp"
 #include "fissure/host_sim/soft_world.hpp"
-#include "machine_info.hpp"
+#include "fissure/session/machine_info.hpp"
 #include "sim_report.hpp"
 
 namespace fissure::app {
+using namespace fissure::session;  // the session library: SessionHost, run_session, LinkBridge, …
 namespace {
 
 /// Node spacings [m] swept, coarse → fine; the last is the reference. The spatula is 30 × 60 mm

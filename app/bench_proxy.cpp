@@ -17,7 +17,7 @@
 // fade, before passivity/safety) as % of the oracle's peak |F|, max |ΔF| per tick, and host CPU
 // time (thread CPU clock) per simulated second, plus host step time median/p99.
 #include "bench_proxy.hpp"
-#include "machine_info.hpp"
+#include "fissure/session/machine_info.hpp"
 
 #include <sys/utsname.h>
 #include <time.h>
@@ -37,17 +37,18 @@
 #include "commands.hpp"
 #include "fissure/falcon_hw/sim_falcon.hpp"
 #include "fissure/host_sim/scene_loader.hpp"
-#include "fissure/rt_core/device_mapping.hpp"
+#include "fissure/shared/device_mapping.hpp"
 #include "fissure/rt_core/hunt_crossley.hpp"
 #include "fissure/rt_core/proxy_intake.hpp"
 #include "fissure/rt_core/rt_config.hpp"
 #include "fissure/rt_core/rt_loop.hpp"
 #include "fissure/shared/clock.hpp"
-#include "session_host.hpp"
-#include "session_record.hpp"
-#include "session_runner.hpp"
+#include "fissure/session/session_host.hpp"
+#include "fissure/session/session_record.hpp"
+#include "fissure/session/session_runner.hpp"
 
 namespace fissure::app {
+using namespace fissure::session;  // the session library: SessionHost, run_session, LinkBridge, …
 namespace {
 
 // Records every reading a device gives (the oracle run), forwarding to the real device.
@@ -100,7 +101,7 @@ double thread_cpu_s() {
 // published (so the error can be split into host divergence, proxy model and blend terms).
 struct RunResult {
   std::vector<Eigen::Vector3d> contact_force_n;  // per tick, device frame (after blend and fade)
-  std::vector<rt::ToolState> tool;               // per tick, as the tick mapped it
+  std::vector<ToolState> tool;               // per tick, as the tick mapped it
   std::vector<double> fade_gain;                 // per tick
   std::vector<std::uint64_t> proxy_sequence;     // per tick: sequence of the proxy in use (0: none)
   std::vector<TimeNs> tick_time_ns;              // per tick: the loop's clock
@@ -120,8 +121,8 @@ RunResult run_once(const host::SceneDescription& scene, const rt::RtModel& model
   SessionHost host(scene);
   host.settle(settle_s);
   const host::ProxyBuilderModel parts_model = proxy_model_for(scene, host.simulation());
-  auto proxy = std::make_unique<rt::ProxyExchange>();
-  auto state = std::make_unique<rt::DeviceStateExchange>();
+  auto proxy = std::make_unique<ProxyExchange>();
+  auto state = std::make_unique<DeviceStateExchange>();
   auto telemetry = std::make_unique<rt::TelemetryRing>();
   rt::RtLoop loop(model, device, clock, *proxy, *state, *telemetry);
   const DeviceMapping& mapping = model.config.mapping;
@@ -147,16 +148,16 @@ RunResult run_once(const host::SceneDescription& scene, const rt::RtModel& model
     result.crossed_nodes_max = std::max(result.crossed_nodes_max, status.crossed_nodes);
     result.proxies.push_back(host.last_proxy());
     const host::HostStepResult& step = host.simulation().last();
-    rt::PartForces host_forces;
+    PartForces host_forces;
     for (int jaw = 0; jaw < step.part_count && jaw < parts_model.jaw_count; ++jaw) {
       const auto j = static_cast<std::size_t>(jaw);
       host_forces.force_world_n[static_cast<std::size_t>(parts_model.part_of_jaw[j])] += step.part_force_world_n[j];
     }
-    result.host_force_n.push_back(rt::part_forces_to_device(mapping, host_forces));
+    result.host_force_n.push_back(part_forces_to_device(mapping, host_forces));
     result.host_tick.push_back(done - 1);
     while (telemetry->try_pop(sample)) {
       result.contact_force_n.push_back(as_eigen(sample.contact_force_device_n));
-      result.tool.push_back(rt::device_to_tool(mapping, as_eigen(sample.position_device_m),
+      result.tool.push_back(device_to_tool(mapping, as_eigen(sample.position_device_m),
                                                as_eigen(sample.velocity_device_m_per_s)));
       result.fade_gain.push_back(sample.fade_gain);
       result.proxy_sequence.push_back(sample.proxy_sequence);
@@ -168,10 +169,10 @@ RunResult run_once(const host::SceneDescription& scene, const rt::RtModel& model
 }
 
 // The device-frame force rt_core's evaluation gives for `proxy` at `tool` (no blend, no fade).
-Eigen::Vector3d raw_proxy_force(const ContactProxy& proxy, const DeviceMapping& mapping, const rt::ToolState& tool) {
-  rt::PartForces forces;
+Eigen::Vector3d raw_proxy_force(const ContactProxy& proxy, const DeviceMapping& mapping, const ToolState& tool) {
+  PartForces forces;
   rt::evaluate_proxy(proxy, mapping, tool, forces);
-  return rt::part_forces_to_device(mapping, forces);
+  return part_forces_to_device(mapping, forces);
 }
 
 
@@ -268,7 +269,7 @@ struct Decomposition {
 class ProxyReplay {
  public:
   explicit ProxyReplay(bool extrapolate = rt::ProxyExtrapolation{}.enabled)
-      : exchange_(std::make_unique<rt::ProxyExchange>()), state_(std::make_unique<rt::ProxyState>()) {
+      : exchange_(std::make_unique<ProxyExchange>()), state_(std::make_unique<rt::ProxyState>()) {
     extrapolation_.enabled = extrapolate;
   }
   const ContactProxy* at(const ContactProxy* incoming, TimeNs now_ns) {
@@ -278,7 +279,7 @@ class ProxyReplay {
   }
 
  private:
-  std::unique_ptr<rt::ProxyExchange> exchange_;
+  std::unique_ptr<ProxyExchange> exchange_;
   std::unique_ptr<rt::ProxyState> state_;
   rt::ProxyExtrapolation extrapolation_;
 };

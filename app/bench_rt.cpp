@@ -25,7 +25,7 @@
 //    mean force over the hold window is ≥ half its equilibrium force against the hand spring
 //    (a wall held back to nothing is passive and still, and not a wall).
 #include "bench_rt.hpp"
-#include "machine_info.hpp"
+#include "fissure/session/machine_info.hpp"
 
 #include <sys/utsname.h>
 #include <unistd.h>
@@ -61,6 +61,7 @@
 #include "fissure/shared/clock.hpp"
 
 namespace fissure::app {
+using namespace fissure::session;  // the session library: SessionHost, run_session, LinkBridge, …
 namespace {
 
 using rt::RtConfig;
@@ -173,8 +174,8 @@ TickTiming time_ticks(int patches) {
   RtModel model;
   if (!rt::build_model(RtConfig{}, model)) throw CommandError("bench rt: default RtConfig does not build");
   ReplayDevice device(circle_counts());
-  auto proxy_in = std::make_unique<rt::ProxyExchange>();
-  auto state_out = std::make_unique<rt::DeviceStateExchange>();
+  auto proxy_in = std::make_unique<ProxyExchange>();
+  auto state_out = std::make_unique<DeviceStateExchange>();
   auto telemetry = std::make_unique<rt::TelemetryRing>();
   auto data = std::make_unique<rt::RtData>();
   rt::reset_data(model, *data);
@@ -331,8 +332,8 @@ RtRunResult run_sched_fifo(double rate_hz, double seconds, const rt::RtThreadCon
   falcon::SimFalconConfig sim_config;
   sim_config.hand = cyclic_press(seconds);
   falcon::SimFalcon sim(sim_config, clock);
-  auto proxy_in = std::make_unique<rt::ProxyExchange>();
-  auto state_out = std::make_unique<rt::DeviceStateExchange>();
+  auto proxy_in = std::make_unique<ProxyExchange>();
+  auto state_out = std::make_unique<DeviceStateExchange>();
   auto telemetry = std::make_unique<rt::TelemetryRing>();
   auto loop = std::make_unique<rt::RtLoop>(*model, sim, clock, *proxy_in, *state_out, *telemetry);
 
@@ -438,8 +439,8 @@ WallRun run_wall(double rate_hz, double stiffness, bool passivity_on) {
   sim_config.hand = hand;
   const double b = sim_config.dynamics.viscous_damping_n_s_per_m;
   falcon::SimFalcon sim(sim_config, clock);
-  rt::ProxyExchange proxy_in;
-  rt::DeviceStateExchange state_out;
+  ProxyExchange proxy_in;
+  DeviceStateExchange state_out;
   auto telemetry = std::make_unique<rt::TelemetryRing>();
   auto loop = std::make_unique<rt::RtLoop>(model, sim, clock, proxy_in, state_out, *telemetry);
 

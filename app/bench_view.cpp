@@ -27,12 +27,13 @@
 #include <nlohmann/json.hpp>
 
 #include "fissure/host_sim/scene_loader.hpp"
-#include "machine_info.hpp"
+#include "fissure/session/machine_info.hpp"
 #include "render_command.hpp"
-#include "session_runner.hpp"
+#include "fissure/session/session_runner.hpp"
 #include "sim_report.hpp"
 
 namespace fissure::app {
+using namespace fissure::session;  // the session library: SessionHost, run_session, LinkBridge, …
 namespace {
 
 struct BenchViewOptions {

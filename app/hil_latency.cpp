@@ -37,14 +37,17 @@
 #include "fissure/rt_core/rt_config.hpp"
 #include "fissure/rt_core/rt_loop.hpp"
 #include "fissure/rt_core/rt_thread.hpp"
-#include "link_bridge.hpp"
-#include "session_host.hpp"
-#include "session_record.hpp"
-#include "session_runner.hpp"
+#include "fissure/session/link_bridge.hpp"
+#include "fissure/session/session_host.hpp"
+#include "fissure/session/session_record.hpp"
+#include "fissure/session/host_loop.hpp"
+#include "fissure/session/rt_stack.hpp"
+#include "fissure/session/session_runner.hpp"
 #include "sim_report.hpp"
-#include "split_device.hpp"
+#include "fissure/session/split_device.hpp"
 
 namespace fissure::app {
+using namespace fissure::session;  // the session library: SessionHost, run_session, LinkBridge, …
 namespace {
 
 /// rt-side bridge pump period [ns] (as `fissure rt`): a quarter of a 1 kHz tick.
@@ -99,9 +102,7 @@ void run(const HilOptions& options) {
   rt::RtConfig config;
   config.rate_hz = options.rate_hz;
   config.mapping = scene.device_mapping;
-  rt::RtModel model;
-  const char* config_error = nullptr;
-  if (!rt::build_model(config, model, &config_error)) throw CommandError(std::string("rt config: ") + config_error);
+  const rt::RtModel model = build_rt_model(config);
 
   MonotonicClock monotonic;
   WakeRecordingClock rt_clock(monotonic);
@@ -119,16 +120,15 @@ void run(const HilOptions& options) {
 
   const auto expected_ticks = static_cast<std::size_t>(options.seconds * options.rate_hz * kBufferMargin) + 1000;
   TimedDevice timed(device->device(), monotonic, expected_ticks);
-  struct Exchanges {
-    rt::ProxyExchange rt_proxy;          // → rt_core
-    rt::DeviceStateExchange rt_state;    // rt_core →
-    rt::TelemetryRing telemetry;
-    rt::ProxyExchange host_proxy;        // host → (split: host bridge)
-    rt::DeviceStateExchange host_state;  // (split: host bridge) → host
-    rt::DeviceStateExchange host_private;  // the sample handed to SessionHost, recorded first
+  struct HostChannels {
+    ProxyExchange proxy;          // host → (split: host bridge)
+    DeviceStateExchange state;    // (split: host bridge) → host
+    DeviceStateExchange host_private;  // the sample handed to SessionHost, recorded first
   };
-  auto ex = std::make_unique<Exchanges>();
-  rt::RtLoop loop(model, timed, rt_clock, ex->rt_proxy, ex->rt_state, ex->telemetry);
+  auto hx = std::make_unique<HostChannels>();
+  RtStack rt(model, timed, rt_clock);
+  rt::RtLoop& loop = rt.loop();
+  RtChannels& rx = rt.channels();
 
   std::unique_ptr<LinkBridge> rt_bridge;
   std::unique_ptr<LinkBridge> host_bridge;
@@ -144,8 +144,8 @@ void run(const HilOptions& options) {
     host_link.session_id = rt_link.session_id + 1;
     host_bridge = std::make_unique<LinkBridge>(*host_carrier, monotonic, host_link, kRtSilentAfter_ns);
   }
-  rt::DeviceStateExchange& host_in = split ? ex->host_state : ex->rt_state;
-  rt::ProxyExchange& host_out = split ? ex->host_proxy : ex->rt_proxy;
+  DeviceStateExchange& host_in = split ? hx->state : rx.state;
+  ProxyExchange& host_out = split ? hx->proxy : rx.proxy;
 
   std::vector<double> tick_us;
   tick_us.reserve(expected_ticks);
@@ -156,17 +156,13 @@ void run(const HilOptions& options) {
   host_record.sample_time_of_sequence_ns.assign(expected_steps, -1);
 
   std::atomic<bool> stop{false};
-  std::atomic<bool> rt_done{false};
   std::atomic<bool> link_failed{false};
-  rt::RtSetupReport setup_report;
   const TimeNs start_ns = monotonic.now();
   const TimeNs end_ns = start_ns + static_cast<TimeNs>(options.seconds * 1e9);
 
-  std::thread rt_thread([&] {
-    rt::RtThreadSetup setup;
-    rt::RtThreadConfig thread_config;
-    thread_config.policy = rt::RtPolicy::kBestEffort;
-    setup_report = setup.apply(thread_config);
+  rt::RtThreadConfig thread_config;
+  thread_config.policy = rt::RtPolicy::kBestEffort;
+  RtThread rt_thread(thread_config, [&] {
     while (!loop.stopped()) {
       if (stop.load(std::memory_order_relaxed) || monotonic.now() >= end_ns) loop.request_stop();
       loop.step();
@@ -174,43 +170,41 @@ void run(const HilOptions& options) {
       if (tick_us.size() < tick_us.capacity()) tick_us.push_back(to_seconds(monotonic.now() - rt_clock.last_wake_ns()) * 1e6);
     }
     loop.send_zero_command();
-    rt_done.store(true, std::memory_order_release);
   });
+  std::atomic<bool> rt_finished{false};
   std::thread service_thread;
   if (split) {
     service_thread = std::thread([&] {
-      TimeNs next = monotonic.now();
-      while (!rt_done.load(std::memory_order_acquire)) {
-        rt_bridge->pump_rt(ex->rt_state, ex->rt_proxy);
-        next += kPumpPeriod_ns;
-        const TimeNs now = monotonic.now();
-        if (now > next) next = now;
-        monotonic.sleep_until(next);
-      }
+      HostLoop pump(monotonic);
+      pump.run(kPumpPeriod_ns, rt_finished, [&] {
+        rt_bridge->pump_rt(rx.state, rx.proxy);
+        return !rt_thread.done();
+      });
     });
   }
+  HostLoop host_loop(monotonic);
   std::thread host_thread([&] {
     const auto period_ns = static_cast<TimeNs>(std::llround(host_dt_s * 1e9));
-    TimeNs next = monotonic.now();
     DeviceState latest{};
     bool have_latest = false;
-    while (!rt_done.load(std::memory_order_acquire)) {
+    host_loop.run(period_ns, rt_finished, [&] {
+      if (rt_thread.done()) return false;
       bool live = true;
       if (split) {
-        host_bridge->pump_host(ex->host_state, ex->host_proxy);
+        host_bridge->pump_host(hx->state, hx->proxy);
         if (host_bridge->failed()) {
           link_failed.store(true);
           stop.store(true);
-          return;
+          return false;
         }
         live = host_bridge->established() && !host_bridge->peer_silent();
       }
       if (live) {
         if (host_in.try_fetch(latest)) have_latest = true;
-        if (have_latest) ex->host_private.publish(latest);
+        if (have_latest) hx->host_private.publish(latest);
         try {
-          const HostStatus& status = host.step(ex->host_private, host_out);
-          if (split) host_bridge->pump_host(ex->host_state, ex->host_proxy);
+          const HostStatus& status = host.step(hx->host_private, host_out);
+          if (split) host_bridge->pump_host(hx->state, hx->proxy);
           if (host_record.step_us.size() < host_record.step_us.capacity()) host_record.step_us.push_back(status.step_cpu_s * 1e6);
           const std::uint64_t sequence = host.last_proxy().sequence;
           if (have_latest && sequence < host_record.sample_time_of_sequence_ns.size()) {
@@ -220,20 +214,13 @@ void run(const HilOptions& options) {
         } catch (const std::exception& e) {
           host_record.error = e.what();
           stop.store(true);
-          return;
+          return false;
         }
       } else {
         ++host_record.paused_steps;
       }
-      next += period_ns;
-      const TimeNs now = monotonic.now();
-      if (now >= next + period_ns) {
-        ++host_record.late;
-        next = now;
-      } else if (now < next) {
-        monotonic.sleep_until(next);
-      }
-    }
+      return true;
+    });
   });
 
   // Telemetry: per tick the proxy in use and its age; drained here so the ring never fills.
@@ -246,14 +233,16 @@ void run(const HilOptions& options) {
   ticks.reserve(expected_ticks);
   rt::TelemetrySample sample;
   std::fprintf(stderr, "hil latency: %s over %s, %.0f s …\n", timed.name(), options.transport.c_str(), options.seconds);
-  while (!rt_done.load(std::memory_order_acquire)) {
+  while (!rt_thread.done()) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    while (ex->telemetry.try_pop(sample)) ticks.push_back({sample.time_ns, sample.proxy_age_ns, sample.proxy_sequence});
+    while (rx.telemetry.try_pop(sample)) ticks.push_back({sample.time_ns, sample.proxy_age_ns, sample.proxy_sequence});
   }
   rt_thread.join();
+  rt_finished.store(true);
   host_thread.join();
   if (service_thread.joinable()) service_thread.join();
-  while (ex->telemetry.try_pop(sample)) ticks.push_back({sample.time_ns, sample.proxy_age_ns, sample.proxy_sequence});
+  host_record.late = host_loop.late_steps();
+  while (rx.telemetry.try_pop(sample)) ticks.push_back({sample.time_ns, sample.proxy_age_ns, sample.proxy_sequence});
   if (link_failed.load()) throw CommandError(host_bridge->status().error);
   if (!host_record.error.empty()) throw CommandError("host step: " + host_record.error);
 
@@ -292,8 +281,8 @@ void run(const HilOptions& options) {
   out["seconds"] = options.seconds;
   out["rt_rate_hz"] = options.rate_hz;
   out["host_rate_hz"] = 1.0 / host_dt_s;
-  out["rt_sched_fifo"] = setup_report.sched_fifo;
-  out["rt_setup_warnings"] = std::string(setup_report.message);
+  out["rt_sched_fifo"] = rt_thread.setup_report().sched_fifo;
+  out["rt_setup_warnings"] = std::string(rt_thread.setup_report().message);
   out["ticks"] = loop.stats().ticks;
   out["overruns"] = loop.stats().overruns;
   out["host_steps"] = host_record.steps;
@@ -331,7 +320,7 @@ void run(const HilOptions& options) {
   std::printf("hil latency: %s over %s, %.1f s, %llu ticks (%llu overruns), %llu host steps, SCHED_FIFO %s\n", timed.name(),
               options.transport.c_str(), options.seconds, static_cast<unsigned long long>(loop.stats().ticks),
               static_cast<unsigned long long>(loop.stats().overruns), static_cast<unsigned long long>(host_record.steps),
-              setup_report.sched_fifo ? "yes" : "no");
+              rt_thread.setup_report().sched_fifo ? "yes" : "no");
   std::printf("  %-22s %10s %10s %10s %8s\n", "measure", "median", "p99", "max", "count");
   for (const char* key : {"device_round_trip_us", "rt_tick_us", "host_step_us", "proxy_age_ms", "end_to_end_ms"}) {
     const nlohmann::json& d = out[key];

@@ -21,6 +21,7 @@
 #include "bench_proxy.hpp"
 #include "stress_command.hpp"
 #include "bench_all.hpp"
+#include "fissure/session/session_error.hpp"
 #include "bench_pareto.hpp"
 
 namespace {
@@ -94,6 +95,9 @@ int main(int argc, char** argv) {
   } catch (const fissure::app::CommandError& e) {
     std::fprintf(stderr, "fissure: error: %s\n", e.what());
     return e.exit_code();
+  } catch (const fissure::session::SessionError& e) {
+    std::fprintf(stderr, "fissure: error: %s\n", e.what());
+    return e.bad_argument() ? kExitUsage : 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "fissure: error: %s\n", e.what());
     return 1;

@@ -13,11 +13,12 @@
 #include <CLI/CLI.hpp>
 
 #include "fissure/host_sim/scene_loader.hpp"
-#include "session_runner.hpp"
+#include "fissure/session/session_runner.hpp"
 
-#include "sigint_flag.hpp"
+#include "fissure/session/sigint_flag.hpp"
 
 namespace fissure::app {
+using namespace fissure::session;  // the session library: SessionHost, run_session, LinkBridge, …
 namespace {
 
 struct RunOptions {

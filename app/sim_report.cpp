@@ -1,7 +1,7 @@
 // Machine info, quantiles and progress output for the host-sim commands (sim_report.hpp).
 #include "sim_report.hpp"
 
-#include "machine_info.hpp"
+#include "fissure/session/machine_info.hpp"
 
 #include <sys/utsname.h>
 #include <unistd.h>
@@ -13,6 +13,7 @@
 #include <thread>
 
 namespace fissure::app {
+using namespace fissure::session;  // the session library: SessionHost, run_session, LinkBridge, …
 
 nlohmann::json sim_machine_info() { return machine_info(); }
 

@@ -23,11 +23,12 @@
 #include "fissure/shared/clock.hpp"
 #include "fissure/shared/fault_injecting_carrier.hpp"
 #include "fissure/shared/loopback_carrier.hpp"
-#include "link_bridge.hpp"
-#include "session_host.hpp"
-#include "session_runner.hpp"
+#include "fissure/session/link_bridge.hpp"
+#include "fissure/session/session_host.hpp"
+#include "fissure/session/session_runner.hpp"
 
 namespace fissure::app {
+using namespace fissure::session;  // the session library: SessionHost, run_session, LinkBridge, …
 namespace {
 
 using Rng = std::mt19937_64;
@@ -484,10 +485,10 @@ bool finite3(const Vec3& v) { return std::isfinite(v[0]) && std::isfinite(v[1]) 
 double norm3(const Vec3& v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
 
 struct Exchanges {
-  rt::ProxyExchange rt_proxy;
-  rt::DeviceStateExchange rt_state;
-  rt::ProxyExchange host_proxy;
-  rt::DeviceStateExchange host_state;
+  ProxyExchange rt_proxy;
+  DeviceStateExchange rt_state;
+  ProxyExchange host_proxy;
+  DeviceStateExchange host_state;
   rt::TelemetryRing telemetry;
 };
 

@@ -21,6 +21,9 @@
 
 #include <toml++/toml.h>
 
+#include "fissure/config/session_tables.hpp"
+#include "fissure/config/table_reader.hpp"
+
 #include "fissure/host_sim/soft_body_builder.hpp"
 #include "fissure/host_sim/tool_mesh_io.hpp"
 
@@ -37,217 +40,11 @@ const char* to_string(SceneCollisionMethod method) noexcept {
 
 namespace {
 
-std::string format_error(const std::string& file, int line, const std::string& field, const std::string& message) {
-  std::ostringstream out;
-  out << file << ':' << line << ": ";
-  if (!field.empty()) out << "field '" << field << "': ";
-  out << message;
-  return out.str();
-}
-
-int line_of(const toml::node& node) { return static_cast<int>(node.source().begin.line); }
-
-// Unit suffixes we recognise at the end of a key, longest first so "_m_per_s2" wins over
-// "_m". Used only to tell "wrong unit" from "unknown key".
-std::string unit_name(const std::string& suffix) {
-  static const std::map<std::string, std::string> kNames{
-      {"m", "metres"}, {"s", "seconds"}, {"kg", "kilograms"}, {"ratio", "a dimensionless ratio"},
-      {"count", "a count"}, {"m_per_s", "metres per second"}, {"m_per_s2", "metres per second squared"},
-      {"n_per_m", "newtons per metre"}, {"n_s_per_m", "newton-seconds per metre"},
-      {"pa_per_m_pow_n", "Pa per metreⁿ (per unit area)"}, {"n_per_m_pow_n", "N per metreⁿ (per triangle)"},
-      {"pa_s_per_m_pow_n_plus_1", "Pa·s per metreⁿ⁺¹ (per unit area)"},
-      {"n_s_per_m_pow_n_plus_1", "N·s per metreⁿ⁺¹ (per triangle)"}, {"deg", "degrees"},
-      {"kpr", "Bullet's kPR coefficient"}, {"kvc", "Bullet's kVC coefficient"}};
-  const auto it = kNames.find(suffix);
-  return it == kNames.end() ? "'" + suffix + "'" : it->second;
-}
-
-/// One TOML table being read: remembers the keys consumed so that finish() can reject the
-/// rest, and knows every field's (stem, unit) so that a different unit is named as such.
-class TableReader {
- public:
-  TableReader(const std::string& file, const toml::table& table, std::string path)
-      : file_(file), table_(table), path_(std::move(path)) {}
-
-  [[noreturn]] void fail(int line, const std::string& key, const std::string& message) const {
-    const std::string field = key.empty() ? path_ : (path_.empty() ? key : path_ + "." + key);
-    throw SceneError(file_, line, field, message);
-  }
-  [[noreturn]] void fail_at(const toml::node& node, const std::string& key, const std::string& message) const {
-    fail(line_of(node), key, message);
-  }
-  int table_line() const { return std::max(1, line_of(table_)); }
-
-  // Declares a field as (stem, unit suffix); unit "" means the key has no unit (names, enums).
-  // Returns the node or nullptr. A missing key with a wrong-unit sibling fails here.
-  const toml::node* find(const std::string& stem, const std::string& unit) {
-    const std::string key = unit.empty() ? stem : stem + "_" + unit;
-    known_.emplace(key, std::make_pair(stem, unit));
-    used_.insert(key);
-    if (const toml::node* node = table_.get(key)) return node;
-    check_wrong_unit(stem, unit);
-    return nullptr;
-  }
-  const toml::node& require(const std::string& stem, const std::string& unit) {
-    const toml::node* node = find(stem, unit);
-    if (node == nullptr) {
-      const std::string key = unit.empty() ? stem : stem + "_" + unit;
-      fail(table_line(), key, "missing field (expected '" + key + "'" + (unit.empty() ? "" : ", in " + unit_name(unit)) + ")");
-    }
-    return *node;
-  }
-
-  double number(const std::string& stem, const std::string& unit, std::optional<double> fallback = std::nullopt) {
-    const std::string key = stem + "_" + unit;
-    const toml::node* node = fallback ? find(stem, unit) : &require(stem, unit);
-    if (node == nullptr) return *fallback;
-    if (auto v = node->value<double>(); v && (node->is_floating_point() || node->is_integer())) {
-      if (!std::isfinite(*v)) fail_at(*node, key, "must be finite");
-      return *v;
-    }
-    fail_at(*node, key, "expected a number in " + unit_name(unit));
-  }
-  double positive(const std::string& stem, const std::string& unit, std::optional<double> fallback = std::nullopt) {
-    const double v = number(stem, unit, fallback);
-    if (!(v > 0.0)) fail(line_for(stem, unit), stem + "_" + unit, "must be > 0 (got " + std::to_string(v) + ")");
-    return v;
-  }
-  double in_range(const std::string& stem, const std::string& unit, double lo, double hi,
-                  std::optional<double> fallback = std::nullopt) {
-    const double v = number(stem, unit, fallback);
-    if (v < lo || v > hi) {
-      std::ostringstream msg;
-      msg << "must be in [" << lo << ", " << hi << "] (got " << v << ")";
-      fail(line_for(stem, unit), stem + "_" + unit, msg.str());
-    }
-    return v;
-  }
-  int count(const std::string& stem, int lo, int hi, std::optional<int> fallback = std::nullopt) {
-    const std::string key = stem + "_count";
-    const toml::node* node = fallback ? find(stem, "count") : &require(stem, "count");
-    if (node == nullptr) return *fallback;
-    if (!node->is_integer()) fail_at(*node, key, "expected an integer");
-    const std::int64_t v = *node->value<std::int64_t>();
-    if (v < lo || v > hi) {
-      fail_at(*node, key, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "] (got " + std::to_string(v) + ")");
-    }
-    return static_cast<int>(v);
-  }
-  /// A unit-less integer (an index, a bit mask).
-  int integer(const std::string& key, int lo, int hi, std::optional<int> fallback = std::nullopt) {
-    const toml::node* node = fallback ? find(key, "") : &require(key, "");
-    if (node == nullptr) return *fallback;
-    if (!node->is_integer()) fail_at(*node, key, "expected an integer");
-    const std::int64_t v = *node->value<std::int64_t>();
-    if (v < lo || v > hi) fail_at(*node, key, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "] (got " + std::to_string(v) + ")");
-    return static_cast<int>(v);
-  }
-  Vec3 vec3(const std::string& stem, const std::string& unit, std::optional<Vec3> fallback = std::nullopt) {
-    const std::string key = unit.empty() ? stem : stem + "_" + unit;
-    const toml::node* node = fallback ? find(stem, unit) : &require(stem, unit);
-    if (node == nullptr) return *fallback;
-    const toml::array* arr = node->as_array();
-    if (arr == nullptr || arr->size() != 3) fail_at(*node, key, "expected an array of 3 numbers" + (unit.empty() ? "" : " in " + unit_name(unit)));
-    Vec3 out{};
-    for (std::size_t i = 0; i < 3; ++i) {
-      const toml::node& e = *arr->get(i);
-      if (!(e.is_floating_point() || e.is_integer())) fail_at(e, key, "element " + std::to_string(i) + " is not a number");
-      out[i] = *e.value<double>();
-      if (!std::isfinite(out[i])) fail_at(e, key, "element " + std::to_string(i) + " must be finite");
-    }
-    return out;
-  }
-  std::string text(const std::string& key, std::optional<std::string> fallback = std::nullopt) {
-    const toml::node* node = fallback ? find(key, "") : &require(key, "");
-    if (node == nullptr) return *fallback;
-    if (!node->is_string()) fail_at(*node, key, "expected a string");
-    return *node->value<std::string>();
-  }
-  bool boolean(const std::string& key, std::optional<bool> fallback = std::nullopt) {
-    const toml::node* node = fallback ? find(key, "") : &require(key, "");
-    if (node == nullptr) return *fallback;
-    if (!node->is_boolean()) fail_at(*node, key, "expected true or false");
-    return *node->value<bool>();
-  }
-  template <typename Enum>
-  Enum choice(const std::string& key, const std::vector<std::pair<std::string, Enum>>& options,
-              std::optional<Enum> fallback = std::nullopt) {
-    const toml::node* node = fallback ? find(key, "") : &require(key, "");
-    if (node == nullptr) return *fallback;
-    std::string valid;
-    for (const auto& [name, value] : options) valid += (valid.empty() ? "" : ", ") + name;
-    if (!node->is_string()) fail_at(*node, key, "expected one of: " + valid);
-    const std::string got = *node->value<std::string>();
-    for (const auto& [name, value] : options) {
-      if (name == got) return value;
-    }
-    fail_at(*node, key, "'" + got + "' is not one of: " + valid);
-  }
-  const toml::table* subtable(const std::string& key, bool required) {
-    known_.emplace(key, std::make_pair(key, std::string{}));
-    used_.insert(key);
-    const toml::node* node = table_.get(key);
-    if (node == nullptr) {
-      if (required) fail(table_line(), key, "missing table [" + (path_.empty() ? key : path_ + "." + key) + "]");
-      return nullptr;
-    }
-    if (!node->is_table()) fail_at(*node, key, "expected a table");
-    return node->as_table();
-  }
-  const toml::array* array_of_tables(const std::string& key) {
-    known_.emplace(key, std::make_pair(key, std::string{}));
-    used_.insert(key);
-    const toml::node* node = table_.get(key);
-    if (node == nullptr) return nullptr;
-    const toml::array* arr = node->as_array();
-    if (arr == nullptr || !arr->is_array_of_tables()) fail_at(*node, key, "expected an array of tables ([[" + key + "]])");
-    return arr;
-  }
-  /// Marks a key as belonging to this table without reading it (shape-specific keys of
-  /// another shape are still "unknown").
-  int line_for(const std::string& stem, const std::string& unit) const {
-    const toml::node* node = table_.get(unit.empty() ? stem : stem + "_" + unit);
-    return node != nullptr ? line_of(*node) : table_line();
-  }
-  /// Every key not consumed is an error: a wrong unit when its stem is a known field's.
-  void finish() const {
-    for (const auto& [key, node] : table_) {
-      const std::string k(key.str());
-      if (used_.count(k) != 0) continue;
-      for (const auto& [known_key, stem_unit] : known_) {
-        const auto& [stem, unit] = stem_unit;
-        if (!unit.empty() && k.rfind(stem + "_", 0) == 0) {
-          fail_at(node, k, "wrong unit: this field is '" + known_key + "' (" + unit_name(unit) + ")");
-        }
-      }
-      std::string valid;
-      for (const auto& [known_key, stem_unit] : known_) valid += (valid.empty() ? "" : ", ") + known_key;
-      fail_at(node, k, "unknown key (valid here: " + valid + ")");
-    }
-  }
-  const std::string& path() const { return path_; }
-
- private:
-  void check_wrong_unit(const std::string& stem, const std::string& unit) const {
-    if (unit.empty()) return;
-    for (const auto& [key, node] : table_) {
-      const std::string k(key.str());
-      if (k != stem + "_" + unit && k.rfind(stem + "_", 0) == 0 && known_.count(k) == 0) {
-        fail_at(node, k, "wrong unit: expected '" + stem + "_" + unit + "' (" + unit_name(unit) + ")");
-      }
-    }
-  }
-
-  const std::string& file_;
-  const toml::table& table_;
-  std::string path_;
-  std::map<std::string, std::pair<std::string, std::string>> known_;
-  std::set<std::string> used_;
-};
-
-std::string child_path(const TableReader& parent, const std::string& key) {
-  return parent.path().empty() ? key : parent.path() + "." + key;
-}
+using config::child_path;
+using config::line_of;
+using config::read_device_mapping;
+using config::read_hand;
+using config::TableReader;
 
 void read_simulation(TableReader& t, SimulationDescription& sim) {
   sim.time_step_s = t.in_range("time_step", "s", 1e-6, 0.1);
@@ -427,77 +224,6 @@ void read_hunt_crossley(TableReader& t, HuntCrossleyDescription& hc) {
   t.finish();
 }
 
-std::array<std::uint8_t, 3> read_permutation(TableReader& t) {
-  const toml::node& node = t.require("axis_permutation", "");
-  const toml::array* arr = node.as_array();
-  std::array<std::uint8_t, 3> out{};
-  std::array<bool, 3> seen{};
-  if (arr == nullptr || arr->size() != 3) t.fail_at(node, "axis_permutation", "expected 3 integers, a permutation of 0, 1, 2");
-  for (std::size_t i = 0; i < 3; ++i) {
-    const auto v = arr->get(i)->value<std::int64_t>();
-    if (!arr->get(i)->is_integer() || !v || *v < 0 || *v > 2 || seen[static_cast<std::size_t>(*v)]) {
-      t.fail_at(node, "axis_permutation", "expected a permutation of 0, 1, 2");
-    }
-    seen[static_cast<std::size_t>(*v)] = true;
-    out[i] = static_cast<std::uint8_t>(*v);
-  }
-  return out;
-}
-
-std::array<std::int8_t, 3> read_signs(TableReader& t) {
-  const toml::node& node = t.require("axis_sign", "");
-  const toml::array* arr = node.as_array();
-  std::array<std::int8_t, 3> out{};
-  if (arr == nullptr || arr->size() != 3) t.fail_at(node, "axis_sign", "expected 3 integers, each 1 or -1");
-  for (std::size_t i = 0; i < 3; ++i) {
-    const auto v = arr->get(i)->value<std::int64_t>();
-    if (!arr->get(i)->is_integer() || !v || (*v != 1 && *v != -1)) t.fail_at(node, "axis_sign", "expected 3 integers, each 1 or -1");
-    out[i] = static_cast<std::int8_t>(*v);
-  }
-  return out;
-}
-
-void read_device_mapping(TableReader& t, DeviceMapping& map) {
-  map.scale = t.positive("scale", "ratio");
-  map.force_scale = t.positive("force_scale", "ratio");
-  map.axis_permutation = read_permutation(t);
-  map.axis_sign = read_signs(t);
-  map.device_origin_m = t.vec3("device_origin", "m");
-  map.world_offset_m = t.vec3("world_offset", "m");
-  map.clamp_mode = t.boolean("clamp_mode");
-  map.closing_axis_world = static_cast<std::uint8_t>(t.integer("closing_axis_world", 0, 2, 2));
-  t.finish();
-}
-
-void read_hand(const std::string& file, TableReader& t, HandScript& hand) {
-  hand.start_position_device_m = t.vec3("start_position_device", "m");
-  hand.grip_stiffness_n_per_m = t.positive("grip_stiffness", "n_per_m");
-  hand.grip_damping_n_s_per_m = t.in_range("grip_damping", "n_s_per_m", 0.0, 1e6);
-  hand.release_at_end = t.boolean("release_at_end");
-  if (const toml::array* legs = t.array_of_tables("waypoint")) {
-    for (std::size_t i = 0; i < legs->size(); ++i) {
-      TableReader w(file, *legs->get(i)->as_table(), child_path(t, "waypoint[" + std::to_string(i) + "]"));
-      HandWaypoint wp;
-      wp.position_device_m = w.vec3("position_device", "m");
-      wp.speed_m_per_s = w.positive("speed", "m_per_s");
-      wp.hold_s = w.in_range("hold", "s", 0.0, 1e6, 0.0);
-      w.finish();
-      hand.waypoints.push_back(wp);
-    }
-  }
-  if (const toml::array* events = t.array_of_tables("button_event")) {
-    for (std::size_t i = 0; i < events->size(); ++i) {
-      TableReader e(file, *events->get(i)->as_table(), child_path(t, "button_event[" + std::to_string(i) + "]"));
-      ButtonEvent ev;
-      ev.time_s = e.in_range("time", "s", 0.0, 1e9);
-      ev.buttons = static_cast<std::uint32_t>(e.integer("buttons", 0, 0xF));  // bit mask of the 4 grip buttons
-      e.finish();
-      hand.button_events.push_back(ev);
-    }
-  }
-  t.finish();
-}
-
 void read_trajectory(const std::string& file, TableReader& t, TrajectoryDescription& traj, bool clamp) {
   traj.start.position_world_m = t.vec3("start_position_world", "m");
   traj.start.orientation_world = quat_from_rpy_deg(t.vec3("start_orientation_rpy", "deg", Vec3{0.0, 0.0, 0.0}));
@@ -571,9 +297,6 @@ SceneDescription parse(const toml::table& root, const std::string& file, const s
 
 }  // namespace
 
-SceneError::SceneError(std::string file, int line, std::string field, const std::string& message)
-    : std::runtime_error(format_error(file, line, field, message)), file_(std::move(file)), line_(line), field_(std::move(field)) {}
-
 SceneDescription load_scene_text(std::string_view toml_text, const std::string& file_label, const std::filesystem::path& base_dir) {
   toml::table root;
   try {
@@ -590,40 +313,6 @@ SceneDescription load_scene(const std::filesystem::path& file) {
   std::stringstream buffer;
   buffer << in.rdbuf();
   return load_scene_text(buffer.str(), file.string(), file.parent_path());
-}
-
-std::filesystem::path find_scenes_dir() {
-  namespace fs = std::filesystem;
-  std::vector<fs::path> candidates;
-  if (const char* env = std::getenv("FISSURE_SCENES_DIR")) candidates.emplace_back(env);
-  candidates.emplace_back(fs::current_path() / "scenes");
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    // build-*/bin/fissure or build-*/tests/x_test: the source tree is two levels up.
-    for (fs::path dir = exe.parent_path(); !dir.empty() && dir != dir.root_path(); dir = dir.parent_path()) {
-      candidates.push_back(dir / "scenes");
-    }
-  }
-  for (const fs::path& c : candidates) {
-    if (fs::is_directory(c, ec)) return c;
-  }
-  return {};
-}
-
-std::filesystem::path resolve_scene_path(std::string_view name_or_path) {
-  namespace fs = std::filesystem;
-  const fs::path given{std::string(name_or_path)};
-  std::error_code ec;
-  if (fs::is_regular_file(given, ec)) return given;
-  const fs::path dir = find_scenes_dir();
-  if (!dir.empty()) {
-    fs::path candidate = dir / given;
-    if (candidate.extension() != ".toml") candidate += ".toml";
-    if (fs::is_regular_file(candidate, ec)) return candidate;
-  }
-  throw SceneError(std::string(name_or_path), 0, "",
-                   "no such scene file or scene name (looked in " + (dir.empty() ? std::string("no scenes/ directory found") : dir.string()) + ")");
 }
 
 Quat quat_from_rpy_deg(const Vec3& rpy_deg) {

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "fissure/rt_core/device_mapping.hpp"
+#include "fissure/shared/device_mapping.hpp"
 
 namespace fissure::rt {
 namespace {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "fissure/rt_core/device_mapping.hpp"
+#include "fissure/shared/device_mapping.hpp"
 #include "fissure/rt_core/faults.hpp"
 #include "fissure/rt_core/forward_kinematics_stage.hpp"
 #include "fissure/rt_core/hunt_crossley.hpp"

@@ -15,7 +15,7 @@
 #include "../falcon_hw/allocation_counter.hpp"
 #include "fissure/host_sim/host_simulation.hpp"
 #include "fissure/host_sim/scene_loader.hpp"
-#include "fissure/rt_core/device_mapping.hpp"
+#include "fissure/shared/device_mapping.hpp"
 #include "fissure/rt_core/hunt_crossley.hpp"
 #include "fissure/rt_core/proxy_intake.hpp"
 #include "fissure/shared/message_validation.hpp"
@@ -49,24 +49,24 @@ Eigen::Vector3d host_force(const std::vector<ContactRecord>& records) {
 // Everything the rt side needs to evaluate a proxy at one tool state.
 struct RtSide {
   DeviceMapping mapping{};
-  rt::ToolState tool{};
+  ToolState tool{};
 
   [[nodiscard]] ProxyPartMotion parts() const {
     ProxyPartMotion m;
     for (ToolPart part : {ToolPart::kTool, ToolPart::kJawA, ToolPart::kJawB}) {
-      const rt::PartMotion pm = rt::part_motion(mapping, tool, part);
+      const PartMotion pm = part_motion(mapping, tool, part);
       m.p_world_m[static_cast<std::size_t>(part)] = pm.p_world_m;
       m.v_world_m_per_s[static_cast<std::size_t>(part)] = pm.v_world_m_per_s;
     }
     return m;
   }
-  [[nodiscard]] rt::PartForces evaluate(const ContactProxy& proxy) const {
-    rt::PartForces forces;
+  [[nodiscard]] PartForces evaluate(const ContactProxy& proxy) const {
+    PartForces forces;
     rt::evaluate_proxy(proxy, mapping, tool, forces);
     return forces;
   }
   [[nodiscard]] Eigen::Vector3d total(const ContactProxy& proxy) const {
-    const rt::PartForces f = evaluate(proxy);
+    const PartForces f = evaluate(proxy);
     return f.force_world_n[0] + f.force_world_n[1] + f.force_world_n[2];
   }
 };
@@ -150,7 +150,7 @@ TEST(ProxyBuilder, MixedDepthsRatesAndFacesReproduceTheHostForceAtTheHostSpeed) 
     ASSERT_EQ(validate(proxy), ProxyError::kNone) << "trial " << trial;
     EXPECT_EQ(proxy.patch_count, used_faces);
     // Per patch the force matches; the per-face host sums are what the patches stand for.
-    const rt::PartForces forces = rt.evaluate(proxy);
+    const PartForces forces = rt.evaluate(proxy);
     expect_within_one_percent(forces.force_world_n[0], host_force(records), "trial " + std::to_string(trial));
   }
 }
@@ -221,7 +221,7 @@ TEST(ProxyBuilder, ClampJawsGetTheirOwnPatchesOnTheirOwnParts) {
   builder.build(records, ToolPose{}, rt.parts(), 0, proxy);
   ASSERT_EQ(validate(proxy), ProxyError::kNone);
   ASSERT_EQ(proxy.patch_count, 2);
-  const rt::PartForces forces = rt.evaluate(proxy);
+  const PartForces forces = rt.evaluate(proxy);
   const std::vector<ContactRecord> jaw0(records.begin(), records.begin() + 8);
   const std::vector<ContactRecord> jaw1(records.begin() + 8, records.end());
   expect_within_one_percent(forces.force_world_n[static_cast<std::size_t>(ToolPart::kJawB)], host_force(jaw0), "jaw 0");
@@ -229,7 +229,7 @@ TEST(ProxyBuilder, ClampJawsGetTheirOwnPatchesOnTheirOwnParts) {
   EXPECT_EQ(forces.force_world_n[0].norm(), 0.0);
   // Closing further (jaws move towards each other) squeezes harder on both.
   rt.tool.jaw_closing_m += 0.001;
-  const rt::PartForces tighter = rt.evaluate(proxy);
+  const PartForces tighter = rt.evaluate(proxy);
   EXPECT_GT(tighter.force_world_n[2].z(), forces.force_world_n[2].z());
   EXPECT_LT(tighter.force_world_n[1].z(), forces.force_world_n[1].z());
 }
@@ -378,7 +378,7 @@ TEST_P(PaperSceneProxy, RtEvaluationAtTheHostPoseIsWithinOnePercentOfTheHostForc
     builder.build(step.contacts, pose, rt.parts(), static_cast<TimeNs>(std::llround(step.time_s * 1e9)), proxy);
     ASSERT_EQ(validate(proxy), ProxyError::kNone) << "t = " << t;
     ASSERT_EQ(builder.last_report().dropped_groups, 0);
-    const rt::PartForces forces = rt.evaluate(proxy);
+    const PartForces forces = rt.evaluate(proxy);
     Eigen::Vector3d host_total = Eigen::Vector3d::Zero();
     for (int jaw = 0; jaw < model.jaw_count; ++jaw) {
       const auto j = static_cast<std::size_t>(jaw);
@@ -429,7 +429,7 @@ HeldProxyError held_proxy_error(const std::string& scene_name, int steps_per_pro
   ProxyBuilder builder(model);
   rt::ProxyExtrapolation extrapolation;
   extrapolation.enabled = extrapolate;
-  auto exchange = std::make_unique<rt::ProxyExchange>();
+  auto exchange = std::make_unique<ProxyExchange>();
   auto state = std::make_unique<rt::ProxyState>();
 
   RtSide rt;

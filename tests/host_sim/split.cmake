@@ -1,13 +1,3 @@
-# Split deployment (issue 6): the link bridge between rt_core / the host and the wire, in
-# lockstep over a loopback link (tests/app/link_bridge_test.cpp mirrors app/link_bridge.cpp).
-# Lives here because host_sim's test directory includes every *.cmake (tests/app does not).
-fissure_add_test(app_link_bridge_test
-  SOURCES ${CMAKE_SOURCE_DIR}/tests/app/link_bridge_test.cpp
-          ${CMAKE_SOURCE_DIR}/app/link_bridge.cpp
-          ${CMAKE_SOURCE_DIR}/app/session_host.cpp
-  LIBS fissure_host_sim fissure_rt_core fissure_falcon_hw fissure_shared)
-target_include_directories(app_link_bridge_test PRIVATE ${CMAKE_SOURCE_DIR}/app)
-
 # Two processes over real UDP on 127.0.0.1 (bounded: ~5 s, every wait has a timeout).
 if(TARGET fissure)
   add_test(NAME app.split_udp_two_processes

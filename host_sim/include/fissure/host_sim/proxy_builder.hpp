@@ -3,7 +3,7 @@
 // ContactProxy that rt_core evaluates at its fast rate against the CURRENT tool position.
 //
 // What a patch must do: rt_core evaluates, per patch and at the position q of the patch's tool part
-// (rt::part_motion: the tool origin, or a clamp jaw),
+// (part_motion: the tool origin, or a clamp jaw),
 //     x = (plane_point − q) · n,   ẋ = −v_q · n,   F = max(0, k·xⁿ + λ·xⁿ·ẋ) · n   for x > 0.
 // The builder picks (plane_point, n, k, λ, n) per patch so that, at the host's part position and
 // part velocity, this reproduces the host's force for the contacts the patch stands for — exactly,
@@ -55,7 +55,7 @@ struct ProxyBuilderModel {
 };
 
 /// Position and velocity of each rt tool part (indexed by ToolPart) at the host's step, world
-/// frame, in rt_core's convention (rt::part_motion of the DeviceState the host stepped to).
+/// frame, in rt_core's convention (part_motion of the DeviceState the host stepped to).
 struct ProxyPartMotion {
   std::array<Eigen::Vector3d, 3> p_world_m{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   std::array<Eigen::Vector3d, 3> v_world_m_per_s{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),

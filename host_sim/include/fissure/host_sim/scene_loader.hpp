@@ -9,22 +9,14 @@
 #include <string>
 #include <string_view>
 
+#include "fissure/config/scene_error.hpp"
+#include "fissure/config/session_tables.hpp"
 #include "fissure/host_sim/scene_description.hpp"
 
 namespace fissure::host {
 
-class SceneError : public std::runtime_error {
- public:
-  SceneError(std::string file, int line, std::string field, const std::string& message);
-  [[nodiscard]] const std::string& file() const noexcept { return file_; }
-  [[nodiscard]] int line() const noexcept { return line_; }      ///< 1-based; 0 when the file is unreadable
-  [[nodiscard]] const std::string& field() const noexcept { return field_; }  ///< dotted key path, e.g. "soft_body.radius_m"
-
- private:
-  std::string file_;
-  int line_;
-  std::string field_;
-};
+/// Scene files share their error type and table reader with every configuration file.
+using config::SceneError;
 
 /// Parses and validates one scene file. Mesh paths are resolved relative to the file's
 /// directory and the mesh is loaded (and checked) here, so a SceneDescription is complete.
@@ -35,14 +27,9 @@ class SceneError : public std::runtime_error {
 [[nodiscard]] SceneDescription load_scene_text(std::string_view toml_text, const std::string& file_label,
                                                const std::filesystem::path& base_dir);
 
-/// Finds a scene: an existing path is taken as is; otherwise NAME (with or without
-/// ".toml") is looked up in $FISSURE_SCENES_DIR, ./scenes, and the scenes/ directory of the
-/// source tree the executable was built in (…/scenes next to build-*/bin/). Throws
-/// SceneError (line 0) listing where it looked.
-[[nodiscard]] std::filesystem::path resolve_scene_path(std::string_view name_or_path);
-
-/// The scenes/ directory found as above (empty when none).
-[[nodiscard]] std::filesystem::path find_scenes_dir();
+/// Scene names resolve the same way for the host and for the RT box (config/session_tables.hpp).
+using config::find_scenes_dir;
+using config::resolve_scene_path;
 
 /// Roll, pitch, yaw [deg] → unit quaternion (w, x, y, z) of R = Rz(yaw)·Ry(pitch)·Rx(roll), the
 /// convention of the scene files' `*_rpy_deg` keys.

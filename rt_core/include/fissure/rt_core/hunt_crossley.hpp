@@ -7,7 +7,7 @@
 //   F  = max(0, k·xⁿ + λ·xⁿ·ẋ) · n   for x > 0, else 0
 // The F ≥ 0 clamp matters when the tool is withdrawn faster than k/λ: the raw formula would
 // pull the tool into the surface (everyone clamps: Simbody, RBD.jl, LIGGGHTS).
-#include "fissure/rt_core/device_mapping.hpp"
+#include "fissure/shared/device_mapping.hpp"
 #include "fissure/shared/messages.hpp"
 #include "fissure/shared/session_config.hpp"
 

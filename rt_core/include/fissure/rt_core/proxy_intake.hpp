@@ -27,13 +27,12 @@
 #include <cstdint>
 
 #include "fissure/shared/latest_value_exchange.hpp"
+#include "fissure/shared/exchanges.hpp"
 #include "fissure/shared/message_validation.hpp"
 #include "fissure/shared/messages.hpp"
 #include "fissure/shared/time.hpp"
 
 namespace fissure::rt {
-
-using ProxyExchange = LatestValueExchange<ContactProxy>;
 
 enum class ProxyIntake : std::uint8_t { kNothingNew, kAccepted, kRejected, kOutOfOrder };
 

@@ -6,7 +6,7 @@
 #include <Eigen/Core>
 
 #include "fissure/falcon_hw/haptic_device.hpp"
-#include "fissure/rt_core/device_mapping.hpp"
+#include "fissure/shared/device_mapping.hpp"
 #include "fissure/rt_core/forward_kinematics_stage.hpp"
 #include "fissure/rt_core/joint_angles.hpp"
 #include "fissure/rt_core/passivity.hpp"

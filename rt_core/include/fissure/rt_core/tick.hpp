@@ -18,12 +18,11 @@
 #include "fissure/rt_core/rt_config.hpp"
 #include "fissure/rt_core/rt_data.hpp"
 #include "fissure/rt_core/telemetry.hpp"
+#include "fissure/shared/exchanges.hpp"
 #include "fissure/shared/latest_value_exchange.hpp"
 #include "fissure/shared/messages.hpp"
 
 namespace fissure::rt {
-
-using DeviceStateExchange = LatestValueExchange<DeviceState>;
 
 /// What the tick talks to. All wait-free except device.try_exchange (bounded I/O).
 struct TickIo {

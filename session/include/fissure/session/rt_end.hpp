@@ -1,0 +1,52 @@
+#pragma once
+// The rt end of a split deployment (docs/deployment.md): the device (SimFalcon with the scene's
+// hand, or the USB Falcon) and rt_core's RtLoop on a real-time thread, joined to a host over
+// CAN FD or UDP by a LinkBridge pumped on a service thread, so the tick never touches the
+// carrier. The calling thread drains telemetry and prints the status line. Host death needs
+// nothing here: no proxy reaches rt_core, whose staleness stage fades the force to zero
+// (stale 0.1 s + fade 0.05 s); the rt end only reports it. Bullet-free: `fissure rt` on a
+// workstation and `fissure-rt` on the RT box run this same code.
+#include <atomic>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "fissure/rt_core/rt_thread.hpp"
+#include "fissure/shared/session_config.hpp"
+
+namespace fissure::session {
+
+struct RtEndOptions {
+  std::string transport;                ///< can:IFACE or udp:HOST:PORT (this box's address)
+  bool usb_device = false;              ///< the USB Falcon; false: SimFalcon
+  DeviceMapping device_mapping{};       ///< the scene's (the host must run the same scene)
+  std::optional<HandScript> hand;       ///< SimFalcon's scripted hand (none: the grip is left free)
+  double rate_hz = 1000.0;              ///< rt tick rate [Hz]
+  double seconds = 0.0;                 ///< run this long, then ramp out; 0 = until interrupted
+  rt::RtPolicy policy = rt::RtPolicy::kBestEffort;
+  bool status_line = true;
+  const char* program = "fissure rt";   ///< names the program in messages
+  /// Set from a signal handler: ramp out and stop (checked every 10 ms).
+  const std::atomic<bool>* interrupt = nullptr;
+};
+
+struct RtEndOutcome {
+  double seconds = 0.0;
+  std::uint64_t ticks = 0;
+  std::uint64_t overruns = 0;
+  bool link_established = false;
+  std::uint64_t proxies_used = 0;
+  double force_max_n = 0.0;
+  std::uint64_t frames_discarded = 0;
+  std::uint64_t messages_discarded = 0;
+  std::uint64_t host_restarts = 0;
+  std::uint64_t fault_ticks = 0;        ///< ticks with a fault bit set (docs/session.md)
+  bool interrupted = false;
+};
+
+/// Runs the rt end and prints its one-line summary on stdout. Throws SessionError when the
+/// set-up fails (device, carrier, rt config, an enforced real-time policy refused) or the host
+/// was refused by the handshake.
+RtEndOutcome run_rt_end(const RtEndOptions& options);
+
+}  // namespace fissure::session

@@ -1,0 +1,89 @@
+#pragma once
+// What a `fissure run` session leaves behind: a per-tick CSV trace (rt telemetry + the newest
+// host status), the summary figures issue 6 names (crossed_nodes_max, faults, overruns,
+// force_max_n, proxy_age_ms {median, p99}, energy_j) and a status line. Runs on the session's
+// main thread (not the rt thread): it may allocate and write files.
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "fissure/rt_core/telemetry.hpp"
+#include "fissure/session/session_host.hpp"
+
+namespace fissure::session {
+
+struct SessionFigures {
+  std::uint64_t ticks = 0;
+  std::uint64_t overruns = 0;
+  std::uint64_t fault_ticks = 0;           ///< ticks with any RtFaultBits fault bit set
+  std::uint32_t fault_bits_seen = 0;       ///< OR of every fault bit seen
+  std::uint64_t telemetry_samples = 0;
+  TimeNs first_tick_time_ns = 0;           ///< loop clock time of the first / last sample
+  TimeNs last_tick_time_ns = 0;
+  double force_max_n = 0.0;                ///< max |commanded device force|
+  double contact_force_max_n = 0.0;        ///< max |proxy force| before passivity/safety
+  double rt_penetration_max_m = 0.0;       ///< deepest proxy penetration rt_core evaluated
+  double energy_j = 0.0;                   ///< passivity observer at the last sample (> 0: active)
+  double energy_max_j = 0.0;               ///< its maximum over the session
+  int crossed_nodes_max = 0;
+  std::uint64_t tool_reseats = 0;          ///< host re-seated its tool (device position epoch changed)
+  double soft_volume_ratio_min = 1.0;      ///< lowest signed soft volume / settled (< 0: turned inside out)
+  double host_penetration_max_m = 0.0;     ///< deepest soft node inside the tool (host)
+  double host_force_max_n = 0.0;
+  std::uint64_t host_steps = 0;
+  std::vector<double> proxy_age_ms;        ///< per tick with a proxy
+  std::vector<double> host_step_ms;        ///< per host step
+  /// Loop-clock time between consecutive telemetry samples [us]: the rt tick period as it
+  /// happened (its jitter is what competition for the CPU, e.g. the view, would show up in).
+  std::vector<double> tick_interval_us;
+};
+
+class SessionRecorder {
+ public:
+  /// Opens `out_dir`/trace.csv (creating the directory). Throws SessionError naming the file
+  /// when it cannot. `expected_ticks` sizes the buffers once.
+  SessionRecorder(const std::filesystem::path& out_dir, std::size_t expected_ticks, std::size_t expected_host_steps);
+  ~SessionRecorder();
+  SessionRecorder(const SessionRecorder&) = delete;
+  SessionRecorder& operator=(const SessionRecorder&) = delete;
+
+  void add_host_step(const HostStatus& host);
+  void add_tick(const rt::TelemetrySample& sample, const HostStatus& host);
+  void close_trace();
+
+  [[nodiscard]] const SessionFigures& figures() const noexcept { return figures_; }
+  /// The newest telemetry sample added (zeros before the first).
+  [[nodiscard]] const rt::TelemetrySample& last_tick() const noexcept { return last_; }
+  [[nodiscard]] const std::filesystem::path& trace_path() const noexcept { return trace_path_; }
+  [[nodiscard]] const std::filesystem::path& out_dir() const noexcept { return out_dir_; }
+
+  /// One status line (no newline): time, tick rate, force, proxy age, overruns, crossed nodes.
+  [[nodiscard]] std::string status_line(double time_s, double tick_rate_hz, double host_rate_hz) const;
+
+ private:
+  std::filesystem::path out_dir_;
+  std::filesystem::path trace_path_;
+  std::FILE* trace_ = nullptr;
+  SessionFigures figures_;
+  rt::TelemetrySample last_{};
+  HostStatus last_host_{};
+};
+
+/// Median and p99 (nearest rank) of `values` (sorted in place); {0, 0} when empty.
+struct Quantiles {
+  double median = 0.0;
+  double p99 = 0.0;
+  double max = 0.0;
+};
+Quantiles quantiles(std::vector<double>& values);
+
+/// Finds tools/plot_session.py (FISSURE_TOOLS_DIR, ./tools, or up from the executable) and runs
+/// it with Debian's /usr/bin/python3 on the trace; returns the PNG path, or "" and `error`.
+std::filesystem::path plot_session(const std::filesystem::path& trace, const std::filesystem::path& png,
+                                   const std::string& title, std::string& error);
+
+}  // namespace fissure::session

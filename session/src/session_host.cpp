@@ -1,0 +1,140 @@
+#include "fissure/session/session_host.hpp"
+
+#include "fissure/shared/message_validation.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include <BulletSoftBody/btSoftBody.h>
+
+#include "fissure/host_sim/soft_world.hpp"
+#include "fissure/shared/device_mapping.hpp"
+
+namespace fissure::session {
+namespace {
+
+static_assert(host::kMaxProxyJaws == host::kMaxToolParts, "one proxy-builder jaw per host tool part");
+
+Eigen::Quaterniond to_quaternion(const Quat& q) { return Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized(); }
+
+}  // namespace
+
+host::ProxyBuilderModel proxy_model_for(const host::SceneDescription& scene, const host::HostSimulation& sim) {
+  host::ProxyBuilderModel model;
+  model.hunt_crossley.k = scene.hunt_crossley.stiffness_k;
+  model.hunt_crossley.lambda = scene.hunt_crossley.damping_lambda;
+  model.hunt_crossley.n = scene.hunt_crossley.exponent_n;
+  model.hunt_crossley.per_unit_area = scene.hunt_crossley.mode == host::HuntCrossleyMode::kPerUnitArea;
+  const bool clamp = scene.tool.kind == host::ToolKind::kClamp;
+  model.jaw_count = clamp ? 2 : 1;
+  // rt_core's clamp convention (rt_core/device_mapping.hpp): jaw A is the one on the −e_c side.
+  // host_sim's jaw 0 sits at tool-local +y (host_simulation.hpp); the tool keeps its start
+  // orientation throughout a session.
+  const Eigen::Vector3d local_y_world = to_quaternion(scene.trajectory.start.orientation_world) * Eigen::Vector3d::UnitY();
+  for (int jaw = 0; jaw < model.jaw_count; ++jaw) {
+    const auto j = static_cast<std::size_t>(jaw);
+    const host::ToolNodes* nodes = sim.tool_nodes(jaw);
+    if (nodes == nullptr) {
+      throw std::invalid_argument("scene '" + scene.name +
+                                  "': fissure run needs the paired or ray collision method (the proxy is built from its contacts)");
+    }
+    model.plane_count[j] = static_cast<int>(nodes->planes().size());
+    if (clamp) {
+      const double side = (jaw == 0 ? 1.0 : -1.0) * local_y_world[scene.device_mapping.closing_axis_world];
+      model.part_of_jaw[j] = side < 0.0 ? ToolPart::kJawA : ToolPart::kJawB;
+    } else {
+      model.part_of_jaw[j] = ToolPart::kTool;
+    }
+  }
+  return model;
+}
+
+SessionHost::SessionHost(const host::SceneDescription& scene)
+    : scene_(scene), sim_(scene), builder_(proxy_model_for(scene, sim_)) {
+  pose_.position_world_m = as_eigen(scene.trajectory.start.position_world_m);
+  pose_.orientation_world = to_quaternion(scene.trajectory.start.orientation_world);
+  settled_volume_m3_ = sim_.world().soft().getVolume();
+}
+
+void SessionHost::settle(double seconds) {
+  sim_.settle(seconds);
+  settled_volume_m3_ = sim_.world().soft().getVolume();
+}
+
+const HostStatus& SessionHost::step(DeviceStateExchange& state_in, ProxyExchange& proxy_out) {
+  const auto start = std::chrono::steady_clock::now();
+  DeviceState incoming;
+  bool rt_restarted = false;
+  if (state_in.try_fetch(incoming)) {
+    // A non-finite sample (a corrupt link, a broken device) would turn Bullet's soft body to
+    // NaN for good: keep the tool at the last finite sample and count the rejection.
+    if (is_finite(incoming)) {
+      // Sequences only grow within one rt_core run: a smaller one is a restarted rt_core, whose
+      // epochs start again and may equal the one applied last.
+      rt_restarted = have_device_ && incoming.sequence < device_.sequence;
+      device_ = incoming;
+      have_device_ = true;
+    } else {
+      ++status_.rejected_device_states;
+    }
+  }
+  const DeviceMapping& mapping = scene_.device_mapping;
+  // Epoch 0: rt_core has accepted no reading yet, its position is not one (messages.hpp).
+  const std::uint8_t epoch = have_device_ ? position_epoch(device_.status_flags) : std::uint8_t{0};
+  ToolState tool;
+  if (epoch != 0) {
+    tool = device_to_tool(mapping, as_eigen(device_.position_device_m), as_eigen(device_.velocity_device_m_per_s));
+  } else {
+    // Before rt_core's first accepted sample: hold the tool where it is (the scene's start pose).
+    tool.p_tool_world_m = pose_.position_world_m;
+    tool.jaw_closing_m = 0.0;
+  }
+  pose_.position_world_m = tool.p_tool_world_m;
+  // rt_core's jaws close by scale·closing in total (each moves scale·closing/2), so the gap is
+  // the open gap less that.
+  const double jaw_gap_m = scene_.tool.clamp.jaw_gap_open_m - mapping.scale * tool.jaw_closing_m;
+  if (epoch != applied_epoch_ || rt_restarted) {
+    // rt_core says this position does not continue the last one (an accepted encoder jump, the
+    // first sample after a device fault, its first sample): the hand did not move the tool
+    // there. Sweeping to it would carry every soft node on the way (10 cm through the ball and
+    // back in the stress case encoder_jumps, which turned it inside out): re-seat the tool. The
+    // step below then starts from rest at the new pose, so its tool velocity is 0, not jump / dt.
+    if (epoch != 0) {
+      sim_.reseat_tool(pose_, jaw_gap_m);
+      ++status_.tool_reseats;
+    }
+    applied_epoch_ = epoch;
+  }
+  const host::HostStepResult& result = sim_.step(pose_, jaw_gap_m);
+
+  host::ProxyPartMotion parts;
+  for (const ToolPart part : {ToolPart::kTool, ToolPart::kJawA, ToolPart::kJawB}) {
+    const PartMotion motion = part_motion(mapping, tool, part);
+    parts.p_world_m[static_cast<std::size_t>(part)] = motion.p_world_m;
+    parts.v_world_m_per_s[static_cast<std::size_t>(part)] = motion.v_world_m_per_s;
+  }
+  const auto host_time_ns = static_cast<TimeNs>(std::llround(result.time_s * 1e9));
+  builder_.build(result.contacts, pose_, parts, host_time_ns, proxy_);
+  proxy_out.publish(proxy_);
+
+  ++status_.steps;
+  status_.host_time_ns = host_time_ns;
+  status_.crossed_nodes = result.crossing.crossed_nodes;
+  status_.contacts = result.contact_count;
+  status_.patches = proxy_.patch_count;
+  status_.max_penetration_m = result.crossing.max_penetration_m;
+  status_.force_n = result.force_on_tool_world_n.norm();
+  status_.jaw_gap_m = result.jaw_gap_m;
+  status_.proxy_sequence = proxy_.sequence;
+  // A closed surface's signed volume (O(faces), cheap beside the step) goes below 0 when the body
+  // is turned inside out; the one-sided collision then meets no triangle and contact silently stops.
+  status_.soft_volume_ratio = settled_volume_m3_ != 0.0 ? sim_.world().soft().getVolume() / settled_volume_m3_
+                                                        : std::numeric_limits<double>::quiet_NaN();
+  status_.soft_everted = status_.soft_everted || status_.soft_volume_ratio < 0.0;
+  status_.step_cpu_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return status_;
+}
+
+}  // namespace fissure::session

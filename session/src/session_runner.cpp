@@ -1,0 +1,443 @@
+#include "fissure/session/session_runner.hpp"
+
+#include "fissure/session/machine_info.hpp"
+#include "fissure/session/usb_falcon.hpp"
+
+#include <sys/utsname.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <memory>
+#include <thread>
+
+#include <spdlog/spdlog.h>
+
+#include "fissure/session/session_error.hpp"
+#include "fissure/falcon_hw/sim_falcon.hpp"
+#include "fissure/rt_core/faults.hpp"
+#include "fissure/rt_core/rt_config.hpp"
+#include "fissure/rt_core/rt_loop.hpp"
+#include "fissure/rt_core/rt_thread.hpp"
+#include "fissure/shared/clock.hpp"
+#include "fissure/shared/spsc_ring.hpp"
+#include "fissure/viewer/render_snapshot.hpp"
+#include "fissure/viewer/session_view.hpp"
+#include "fissure/session/host_loop.hpp"
+#include "fissure/session/rt_stack.hpp"
+#include "fissure/session/session_host.hpp"
+
+namespace fissure::session {
+namespace {
+
+using WallClock = std::chrono::steady_clock;
+
+/// Status line refresh [s]: ~10×/s (issue 6), slow enough not to cost the host thread CPU.
+constexpr double kStatusPeriod_s = 0.1;
+/// How often the main thread drains telemetry in real time [ms]: the 8192-sample ring holds
+/// 8 s at 1 kHz, so 10 ms is far inside it and keeps Ctrl-C responsive.
+constexpr int kDrainPeriod_ms = 10;
+/// Host statuses buffered between drains: 4096 host steps ≥ 4 s at 1 kHz.
+constexpr std::size_t kHostStatusCapacity = 4096;
+
+/// Host statuses from the host thread to the main thread (real time). Large: on the heap.
+using HostStatusRing = SpscRing<HostStatus, kHostStatusCapacity>;
+
+nlohmann::json quantile_json(std::vector<double> values) {
+  const Quantiles q = quantiles(values);
+  return {{"median", q.median}, {"p99", q.p99}, {"max", q.max}};
+}
+
+nlohmann::json fault_names(std::uint32_t bits) {
+  nlohmann::json names = nlohmann::json::array();
+  for (std::uint32_t bit = 1; bit != 0 && bit <= rt::kAnyFault; bit <<= 1u) {
+    if ((bits & bit) != 0) names.push_back(rt::fault_name(bit));
+  }
+  return names;
+}
+
+// Prints the status line: in place on a terminal, one line per second otherwise (logs, CI).
+class StatusPrinter {
+ public:
+  explicit StatusPrinter(bool enabled) : enabled_(enabled), tty_(isatty(STDERR_FILENO) == 1) {}
+  void maybe_print(const SessionRecorder& recorder, double session_time_s, std::uint64_t ticks, std::uint64_t host_steps) {
+    if (!enabled_) return;
+    const WallClock::time_point now = WallClock::now();
+    const double since = std::chrono::duration<double>(now - last_).count();
+    if (since < (tty_ ? kStatusPeriod_s : 1.0)) return;
+    const double tick_rate = static_cast<double>(ticks - last_ticks_) / since;
+    const double host_rate = static_cast<double>(host_steps - last_host_steps_) / since;
+    const std::string line = recorder.status_line(session_time_s, tick_rate, host_rate);
+    std::fprintf(stderr, tty_ ? "\r%s\033[K" : "%s\n", line.c_str());
+    last_ = now;
+    last_ticks_ = ticks;
+    last_host_steps_ = host_steps;
+    printed_ = true;
+  }
+  void finish() {
+    if (enabled_ && tty_ && printed_) std::fprintf(stderr, "\n");
+  }
+
+ private:
+  bool enabled_;
+  bool tty_;
+  bool printed_ = false;
+  WallClock::time_point last_ = WallClock::now();
+  std::uint64_t last_ticks_ = 0;
+  std::uint64_t last_host_steps_ = 0;
+};
+
+// The rt side of the view's overlay, from the telemetry drained so far. Tick rate over windows
+// of at least kRateWindow_s of loop-clock time (one 10 ms drain is too short to read steadily).
+class RtFiguresTracker {
+ public:
+  static constexpr double kRateWindow_s = 0.25;
+  viewer::RtFigures update(const SessionRecorder& recorder) {
+    const rt::TelemetrySample& s = recorder.last_tick();
+    if (recorder.figures().telemetry_samples == 0) return figures_;
+    if (!started_) {
+      started_ = true;
+      window_tick_ = s.tick;
+      window_start_ns_ = s.time_ns;
+    }
+    const double span_s = to_seconds(s.time_ns - window_start_ns_);
+    if (span_s >= kRateWindow_s) {
+      figures_.tick_rate_hz = static_cast<double>(s.tick - window_tick_) / span_s;
+      window_tick_ = s.tick;
+      window_start_ns_ = s.time_ns;
+    }
+    figures_.force_n = as_eigen(s.force_device_n).norm();
+    figures_.proxy_age_ms = s.proxy_sequence != 0 ? static_cast<double>(s.proxy_age_ns) * 1e-6 : std::numeric_limits<double>::quiet_NaN();
+    figures_.overruns = static_cast<std::int64_t>(s.overruns);
+    return figures_;
+  }
+
+ private:
+  bool started_ = false;
+  std::uint64_t window_tick_ = 0;
+  TimeNs window_start_ns_ = 0;
+  viewer::RtFigures figures_{};
+};
+
+bool interrupted(const SessionOptions& options) {
+  return options.interrupt != nullptr && options.interrupt->load(std::memory_order_relaxed);
+}
+
+}  // namespace
+
+double hand_script_duration_s(const HandScript& hand) {
+  double total = 0.0;
+  Eigen::Vector3d from = as_eigen(hand.start_position_device_m);
+  for (const HandWaypoint& leg : hand.waypoints) {
+    const Eigen::Vector3d to = as_eigen(leg.position_device_m);
+    if (leg.speed_m_per_s > 0.0) total += (to - from).norm() / leg.speed_m_per_s;
+    total += leg.hold_s;
+    from = to;
+  }
+  return total;
+}
+
+host::SceneDescription scene_at_host_rate(const host::SceneDescription& scene, double host_rate_hz) {
+  host::SceneDescription out = scene;
+  if (host_rate_hz <= 0.0) return out;
+  const double sub_step_s = scene.simulation.time_step_s / scene.simulation.substeps_count;
+  const double host_dt_s = 1.0 / host_rate_hz;
+  const double substeps = host_dt_s / sub_step_s;
+  const long rounded = std::lround(substeps);
+  if (rounded < 1 || std::abs(substeps - static_cast<double>(rounded)) > 1e-6 * substeps) {
+    throw SessionError("--host-rate " + std::to_string(host_rate_hz) + " Hz: the host period must be a whole number of the scene's " +
+                       std::to_string(sub_step_s * 1e3) + " ms collision sub-steps");
+  }
+  out.simulation.time_step_s = host_dt_s;
+  out.simulation.substeps_count = static_cast<int>(rounded);
+  return out;
+}
+
+SessionOutcome run_session(const SessionOptions& options) {
+  const host::SceneDescription scene = scene_at_host_rate(options.scene, options.host_rate_hz);
+  if (options.lockstep && options.device == SessionDevice::kUsb) {
+    throw SessionError("--lockstep runs on simulated time: it needs --device sim, not the USB Falcon");
+  }
+  rt::RtConfig config;
+  config.rate_hz = options.rt_rate_hz;
+  config.mapping = scene.device_mapping;
+  config.passivity.enabled = options.passivity_controller;
+  const rt::RtModel model = build_rt_model(config);
+
+  const double host_dt_s = scene.simulation.time_step_s;
+  double duration_s = options.duration_s;
+  if (duration_s <= 0.0 && options.device == SessionDevice::kSim) duration_s = hand_script_duration_s(scene.hand);
+  if (duration_s <= 0.0 && options.lockstep) throw SessionError("--lockstep needs a duration: the scene's hand script is empty");
+  const bool until_interrupted = duration_s <= 0.0;
+
+  SessionHost host(scene);
+  host.settle(options.settle_s);
+
+  const double expected_s = until_interrupted ? 60.0 : duration_s + 1.0;
+  // The view's picture model is built from the settled body (its rest shape is what the
+  // deformation colours are measured from), here, before any thread steps the simulation, and
+  // its sinks (window, frame writer) start before the first tick. (Started after the rt
+  // thread's mlockall instead, Mesa mapping and locking LLVM cost the running rt loop a 30 ms
+  // gap and 71 overruns on this VM; started before, the cost is a longer rt set-up, measured in
+  // summary.json's rt_setup.seconds, and the session's length counts from the first tick.)
+  std::optional<viewer::RenderModel> view_model;
+  if (options.view || !options.frames_dir.empty()) {
+    try {
+      view_model = viewer::make_render_model(host.simulation());
+    } catch (const std::exception& e) {
+      throw SessionError(std::string("--view/--frames: ") + e.what());
+    }
+  }
+  std::unique_ptr<viewer::SessionView> view;
+  std::string view_error;
+  const auto start_view = [&] {
+    viewer::SessionViewOptions vo;
+    vo.window = options.view;
+    vo.window_options.width_px = options.frame_width_px;
+    vo.window_options.height_px = options.frame_height_px;
+    vo.window_options.method_switching = false;  // a session cannot swap its method under the hand
+    vo.window_options.screenshot_dir = options.out_dir;
+    vo.frames_dir = options.frames_dir;
+    vo.frame_every_steps = options.frame_every;
+    vo.frame_width_px = options.frame_width_px;
+    vo.frame_height_px = options.frame_height_px;
+    vo.wait_for_frames = options.lockstep;
+    vo.expected_host_steps = static_cast<std::size_t>(expected_s / host_dt_s);
+    std::string notice;
+    view = viewer::SessionView::start(*view_model, vo, view_error, notice);
+    if (!view) view_error = "--frames: " + view_error;
+    if (!notice.empty()) std::fprintf(stderr, "%s\n", notice.c_str());
+  };
+  if (view_model) {
+    start_view();
+    if (!view) throw SessionError(view_error);
+  }
+  RtFiguresTracker rt_figures;
+  SessionRecorder recorder(options.out_dir, static_cast<std::size_t>(expected_s * options.rt_rate_hz),
+                           static_cast<std::size_t>(expected_s / host_dt_s));
+  StatusPrinter status(options.status_line);
+  nlohmann::json extra;
+  const WallClock::time_point wall_start = WallClock::now();
+  double session_time_s = 0.0;
+  std::uint64_t proxies_rejected = 0;
+  std::uint64_t host_late_steps = 0;
+  std::uint64_t host_status_dropped = 0;
+  double wakeup_median_us = 0.0;
+  double wakeup_p99_us = 0.0;
+  double wakeup_max_us = 0.0;
+  double max_tick_us = 0.0;
+  std::string device_name;
+
+  falcon::SimFalconConfig sim_config;
+  sim_config.hand = scene.hand;
+
+  if (options.lockstep) {
+    LockstepClock clock(0);
+    falcon::SimFalcon device(sim_config, clock);
+    device_name = device.name();
+    RtStack rt(model, device, clock);
+    rt::RtLoop& loop = rt.loop();
+    RtChannels& channels = rt.channels();
+    const double ratio = host_dt_s / model.period_s;
+    const auto ticks_per_host = static_cast<std::uint64_t>(std::llround(ratio));
+    if (ticks_per_host < 1 || std::abs(ratio - static_cast<double>(ticks_per_host)) > 1e-6 * ratio) {
+      throw SessionError("--lockstep: the host period (" + std::to_string(host_dt_s * 1e3) +
+                         " ms) must be a whole number of rt periods (" + std::to_string(model.period_s * 1e3) + " ms)");
+    }
+    const auto end_ns = static_cast<TimeNs>(std::llround(duration_s * 1e9));
+    rt::TelemetrySample sample;
+    while (!loop.stopped()) {
+      if (clock.now() >= end_ns || interrupted(options)) loop.request_stop();
+      for (std::uint64_t k = 0; k < ticks_per_host && !loop.stopped(); ++k) loop.step();
+      const HostStatus& host_status = host.step(channels.state, channels.proxy);
+      recorder.add_host_step(host_status);
+      while (channels.telemetry.try_pop(sample)) recorder.add_tick(sample, host_status);
+      if (view) {
+        view->rt_figures().publish(rt_figures.update(recorder));
+        view->on_host_step(host.simulation(), &host.last_proxy());
+      }
+      session_time_s = to_seconds(clock.now());
+      status.maybe_print(recorder, session_time_s, recorder.figures().ticks, recorder.figures().host_steps);
+    }
+    loop.send_zero_command();
+    proxies_rejected = loop.data().proxy.rejected_count;
+    extra["sim_falcon"] = {{"exchanges", device.counters().exchanges},
+                           {"kinematics_failures", device.counters().kinematics_failures}};
+  } else {
+    MonotonicClock clock;
+    std::unique_ptr<falcon::HapticDevice> device;
+    std::unique_ptr<UsbFalcon> usb;
+    if (options.device == SessionDevice::kUsb) {
+      usb = UsbFalcon::open(clock);
+    } else {
+      device = std::make_unique<falcon::SimFalcon>(sim_config, clock);
+    }
+    falcon::HapticDevice& haptic = usb ? usb->device() : *device;
+    device_name = haptic.name();
+    RtStack rt(model, haptic, clock);
+    rt::RtLoop& loop = rt.loop();
+    RtChannels& channels = rt.channels();
+    auto host_statuses = std::make_unique<HostStatusRing>();
+    std::atomic<bool> stop_rt{false};
+    std::atomic<bool> stop_host{false};
+    std::atomic<std::uint64_t> dropped{0};
+    std::string host_error;
+    const TimeNs start_ns = clock.now();
+    const TimeNs end_ns = until_interrupted ? std::numeric_limits<TimeNs>::max()
+                                            : start_ns + static_cast<TimeNs>(std::llround(duration_s * 1e9));
+
+    rt::RtThreadConfig thread_config;
+    thread_config.policy = rt::RtPolicy::kBestEffort;
+    RtThread rt_thread(thread_config, [&] {
+      // The session's length counts from the first tick, not from before the set-up.
+      loop.run_until(until_interrupted ? end_ns : clock.now() + (end_ns - start_ns), stop_rt);
+    });
+    HostLoop host_loop(clock);
+    std::thread host_thread([&] {
+      host_loop.run(static_cast<TimeNs>(std::llround(host_dt_s * 1e9)), stop_host, [&] {
+        try {
+          const HostStatus& st = host.step(channels.state, channels.proxy);
+          if (!host_statuses->try_push(st)) dropped.fetch_add(1, std::memory_order_relaxed);
+          // Wait-free hand-off to the window / frame writer threads (never waits in real time).
+          if (view) view->on_host_step(host.simulation(), &host.last_proxy());
+          return true;
+        } catch (const std::exception& e) {
+          host_error = e.what();
+          stop_rt.store(true);  // the proxy goes stale and fades; ramp out and stop
+          return false;
+        }
+      });
+    });
+
+    rt::TelemetrySample sample;
+    HostStatus host_status;
+    auto drain = [&] {
+      while (host_statuses->try_pop(host_status)) recorder.add_host_step(host_status);
+      while (channels.telemetry.try_pop(sample)) recorder.add_tick(sample, host_status);
+    };
+    while (!rt_thread.done()) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(kDrainPeriod_ms));
+      if (interrupted(options)) stop_rt.store(true);
+      drain();
+      if (view) view->rt_figures().publish(rt_figures.update(recorder));
+      session_time_s = to_seconds(clock.now() - start_ns);
+      status.maybe_print(recorder, session_time_s, recorder.figures().ticks, recorder.figures().host_steps);
+    }
+    rt_thread.join();
+    stop_host.store(true);
+    host_thread.join();
+    drain();
+    if (!host_error.empty()) spdlog::error("host thread stopped: {}", host_error);
+    proxies_rejected = loop.data().proxy.rejected_count;
+    host_late_steps = host_loop.late_steps();
+    host_status_dropped = dropped.load();
+    wakeup_median_us = loop.stats().wakeup.quantile_us(0.5);
+    wakeup_p99_us = loop.stats().wakeup.quantile_us(0.99);
+    wakeup_max_us = loop.stats().wakeup.quantile_us(1.0);
+    max_tick_us = static_cast<double>(loop.stats().max_tick_ns) * 1e-3;
+    const rt::RtSetupReport& setup_report = rt_thread.setup_report();
+    extra["rt_setup"] = {{"sched_fifo", setup_report.sched_fifo},
+                         {"memory_locked", setup_report.memory_locked},
+                         {"seconds", rt_thread.setup_seconds()},
+                         {"warnings", std::string(setup_report.message)}};
+    if (setup_report.message[0] != '\0') spdlog::warn("rt thread: {}", setup_report.message);
+    if (!host_error.empty()) extra["host_error"] = host_error;
+  }
+  status.finish();
+  recorder.close_trace();
+  std::optional<viewer::SessionViewStats> view_stats;
+  if (view) view_stats = view->finish();
+  const double wall_s = std::chrono::duration<double>(WallClock::now() - wall_start).count();
+
+  const SessionFigures& f = recorder.figures();
+  nlohmann::json summary;
+  summary["scene"] = scene.name;
+  summary["mode"] = options.lockstep ? "lockstep" : "realtime";
+  summary["device"] = device_name;
+  summary["duration_s"] = session_time_s;
+  summary["wall_s"] = wall_s;
+  summary["rt_rate_hz"] = options.rt_rate_hz;
+  summary["host_rate_hz"] = 1.0 / host_dt_s;
+  summary["ticks"] = f.ticks;
+  // Over the ticks the loop ran (first to last telemetry sample), not the set-up before it.
+  const double ticking_s = to_seconds(f.last_tick_time_ns - f.first_tick_time_ns);
+  summary["tick_rate_hz"] = ticking_s > 0.0 ? static_cast<double>(f.telemetry_samples - 1) / ticking_s : 0.0;
+  summary["crossed_nodes_max"] = f.crossed_nodes_max;
+  summary["tool_reseats"] = f.tool_reseats;
+  summary["soft_volume_ratio_min"] = f.soft_volume_ratio_min;
+  summary["soft_everted"] = f.soft_volume_ratio_min < 0.0;
+  summary["faults"] = f.fault_ticks;
+  summary["fault_kinds"] = fault_names(f.fault_bits_seen);
+  summary["proxies_rejected"] = proxies_rejected;
+  summary["overruns"] = f.overruns;
+  summary["force_max_n"] = f.force_max_n;
+  summary["force_limit_n"] = model.config.safety.max_force_n;
+  summary["contact_force_max_n"] = f.contact_force_max_n;
+  summary["host_force_max_n"] = f.host_force_max_n;
+  std::vector<double> ages = f.proxy_age_ms;
+  summary["proxy_age_ms"] = quantile_json(std::move(ages));
+  summary["energy_j"] = f.energy_j;
+  summary["energy_max_j"] = f.energy_max_j;
+  summary["passivity_controller"] = options.passivity_controller;
+  summary["contact_depth_max_mm"] = f.rt_penetration_max_m * 1e3;
+  summary["host_penetration_max_mm"] = f.host_penetration_max_m * 1e3;
+  summary["host_steps"] = f.host_steps;
+  summary["host_step_ms"] = quantile_json(f.host_step_ms);
+  summary["host_late_steps"] = host_late_steps;
+  summary["host_status_dropped"] = host_status_dropped;
+  if (!options.lockstep) {
+    summary["wakeup_latency_us"] = {{"median", wakeup_median_us}, {"p99", wakeup_p99_us}, {"max", wakeup_max_us}};
+    summary["max_tick_us"] = max_tick_us;
+    std::vector<double> intervals = f.tick_interval_us;
+    summary["tick_interval_us"] = quantile_json(std::move(intervals));
+  }
+  if (view_stats) {
+    nlohmann::json v;
+    v["window"] = {{"requested", options.view}, {"open", view_stats->window_open}, {"frames_drawn", view_stats->window_frames}};
+    if (!options.frames_dir.empty()) {
+      v["frames"] = {{"dir", options.frames_dir.string()},
+                     {"every_host_steps", options.frame_every},
+                     {"published", view_stats->frames_published},
+                     {"written", view_stats->frames_written},
+                     {"dropped", view_stats->frames_dropped},
+                     {"waited_for", options.lockstep},
+                     {"frame_ms", quantile_json([&] {
+                        std::vector<double> ms;
+                        for (const double t : view_stats->frame_s) ms.push_back(t * 1e3);
+                        return ms;
+                      }())},
+                     {"gl", view_stats->gl_description},
+                     {"error", view_stats->frames_error}};
+    }
+    std::vector<double> publish_us;
+    for (const double t : view_stats->capture_publish_s) publish_us.push_back(t * 1e6);
+    v["capture_publish_us"] = quantile_json(std::move(publish_us));
+    summary["view"] = v;
+    if (!view_stats->frames_error.empty()) spdlog::error("--frames: {}", view_stats->frames_error);
+  }
+  summary["telemetry_samples"] = f.telemetry_samples;
+  for (const auto& [key, value] : extra.items()) summary[key] = value;
+  summary["machine"] = machine_info();
+
+  SessionOutcome outcome;
+  outcome.trace_path = recorder.trace_path();
+  outcome.summary_path = options.out_dir / "summary.json";
+  {
+    std::ofstream out(outcome.summary_path);
+    if (!out) throw SessionError("cannot write '" + outcome.summary_path.string() + "'");
+    out << summary.dump(2) << "\n";
+  }
+  if (options.plot) {
+    std::string error;
+    outcome.plot_path = plot_session(outcome.trace_path, options.out_dir / "session.png",
+                                     scene.name + (options.lockstep ? " (lockstep)" : " (real time)"), error);
+    if (outcome.plot_path.empty()) spdlog::warn("{}", error);
+  }
+  outcome.summary = std::move(summary);
+  return outcome;
+}
+
+}  // namespace fissure::session
