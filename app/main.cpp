@@ -5,24 +5,25 @@
 
 #include <CLI/CLI.hpp>
 
-#include "bench_kinematics.hpp"
-#include "bench_rt.hpp"
+#include "bench_kinematics_command.hpp"
+#include "bench_rt_command.hpp"
 #include "commands.hpp"
 #include "device_kinematics.hpp"
 #include "device_usb.hpp"
 #include "sim_command.hpp"
-#include "bench_collision.hpp"
+#include "bench_collision_command.hpp"
 #include "run_command.hpp"
 #include "render_command.hpp"
-#include "bench_view.hpp"
+#include "bench_view_command.hpp"
 #include "rt_command.hpp"
 #include "host_command.hpp"
-#include "hil_latency.hpp"
-#include "bench_proxy.hpp"
+#include "hil_latency_command.hpp"
+#include "bench_proxy_command.hpp"
 #include "stress_command.hpp"
-#include "bench_all.hpp"
+#include "bench_all_command.hpp"
+#include "fissure/eval/eval_error.hpp"
 #include "fissure/session/session_error.hpp"
-#include "bench_pareto.hpp"
+#include "bench_pareto_command.hpp"
 
 namespace {
 
@@ -95,6 +96,9 @@ int main(int argc, char** argv) {
   } catch (const fissure::app::CommandError& e) {
     std::fprintf(stderr, "fissure: error: %s\n", e.what());
     return e.exit_code();
+  } catch (const fissure::eval::EvalError& e) {
+    std::fprintf(stderr, "fissure: error: %s\n", e.what());
+    return e.bad_argument() ? kExitUsage : 1;
   } catch (const fissure::session::SessionError& e) {
     std::fprintf(stderr, "fissure: error: %s\n", e.what());
     return e.bad_argument() ? kExitUsage : 1;

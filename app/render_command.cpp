@@ -20,9 +20,10 @@
 #include "fissure/viewer/orbit_camera.hpp"
 #include "fissure/viewer/render_snapshot.hpp"
 #include "fissure/viewer/view_window.hpp"
-#include "sim_report.hpp"
+#include "fissure/eval/sim_report.hpp"
 
 namespace fissure::app {
+using namespace fissure::eval;  // sim_quantile, SimProgress, sim_machine_info
 namespace {
 
 using Clock = std::chrono::steady_clock;

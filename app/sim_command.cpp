@@ -21,9 +21,10 @@
 #include "fissure/host_sim/tool_mesh_io.hpp"
 #include "fissure/viewer/render_snapshot.hpp"
 #include "fissure/viewer/session_view.hpp"
-#include "sim_report.hpp"
+#include "fissure/eval/sim_report.hpp"
 
 namespace fissure::app {
+using namespace fissure::eval;  // sim_quantile, SimProgress, sim_machine_info
 
 namespace {
 

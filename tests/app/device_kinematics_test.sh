@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # `fissure device kinematics` and `fissure bench kinematics` (app/device_kinematics.cpp,
-# app/bench_kinematics.cpp): JSON out, IK/FK agree, clear errors outside the workspace.
+# eval/src/bench_kinematics.cpp): JSON out, IK/FK agree, clear errors outside the workspace.
 set -u
 fissure=${1:?usage: device_kinematics_test.sh <path to fissure>}
 fail() { echo "FAIL: $*"; exit 1; }

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# `fissure stress --jobs N` runs cases in child processes (app/stress_parallel.cpp): the rows
+# `fissure stress --jobs N` runs cases in child processes (eval/src/stress_parallel.cpp): the rows
 # must be the ones the in-process run gives (same figures, same order), since each case is
 # deterministic from its own seed — only the wall time may differ.
 set -euo pipefail

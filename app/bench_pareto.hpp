@@ -1,9 +1,0 @@
-#pragma once
-// `fissure bench pareto --json FILE [--scene S] [--quick]`: host step time against host force
-// error over the two host knobs no other benchmark sweeps — tool node spacing (coarse → fine)
-// and Bullet sub-steps per host step (issue 7's Pareto plots (b) and (c)).
-#include "commands.hpp"
-
-namespace fissure::app {
-void register_bench_pareto(CommandTree& tree);
-}

@@ -1,0 +1,21 @@
+#pragma once
+// `fissure bench collision`: the thin-body collision methods measured (bench_collision.cpp
+// says what each of the four parts measures). Prints its tables as it runs.
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace fissure::eval {
+
+struct BenchCollisionOptions {
+  bool quick = false;              ///< CI-sized: fewer speeds and meshes, shorter holds
+  bool full = false;               ///< more timing samples per cost-vs-mesh row; the same cells
+  std::vector<std::string> only;   ///< parts to run (empty: all): sweep, indentation, scaling
+  [[nodiscard]] bool runs(const char* part) const;
+};
+
+/// Runs the benchmark; the JSON the report reads. Throws EvalError when the scene does not load.
+[[nodiscard]] nlohmann::json run_bench_collision(const BenchCollisionOptions& options);
+
+}  // namespace fissure::eval
