@@ -298,21 +298,11 @@ SceneDescription parse(const toml::table& root, const std::string& file, const s
 }  // namespace
 
 SceneDescription load_scene_text(std::string_view toml_text, const std::string& file_label, const std::filesystem::path& base_dir) {
-  toml::table root;
-  try {
-    root = toml::parse(toml_text, file_label);
-  } catch (const toml::parse_error& e) {
-    throw SceneError(file_label, static_cast<int>(e.source().begin.line), "", "TOML syntax error: " + std::string(e.description()));
-  }
-  return parse(root, file_label, base_dir);
+  return parse(config::parse_toml(toml_text, file_label), file_label, base_dir);
 }
 
 SceneDescription load_scene(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw SceneError(file.string(), 0, "", "cannot open the scene file");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return load_scene_text(buffer.str(), file.string(), file.parent_path());
+  return load_scene_text(config::read_config_file(file), file.string(), file.parent_path());
 }
 
 Quat quat_from_rpy_deg(const Vec3& rpy_deg) {
