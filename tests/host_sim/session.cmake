@@ -1,4 +1,4 @@
-# `fissure run SCENE --lockstep` end to end for every paper scene (issue 6): the safety checks
+# `fissure run SCENE --lockstep` end to end for every paper scene: the safety checks
 # run the session (a fixture), the passivity check reads the summary it wrote.
 if(TARGET fissure)
   foreach(scene spatula-sphere convex-spatula-sphere clamp-sphere clamp-vessel)

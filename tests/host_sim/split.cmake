@@ -1,4 +1,4 @@
-# Split deployment (issue 6): the link bridge between rt_core / the host and the wire, in
+# Split deployment: the link bridge between rt_core / the host and the wire, in
 # lockstep over a loopback link (tests/app/link_bridge_test.cpp mirrors app/link_bridge.cpp).
 # Lives here because host_sim's test directory includes every *.cmake (tests/app does not).
 fissure_add_test(app_link_bridge_test
