@@ -1,4 +1,4 @@
-# The benchmark report (issue 7): tools/report/make_report.py run on a fixed JSON fixture
+# The benchmark report: tools/report/make_report.py run on a fixed JSON fixture
 # (tests/app/report_fixture/) — every required section, linked PNGs that exist, met/missed marks.
 # `fissure bench all` itself takes ~10 minutes and is not a ctest. Debian's python3 (the one with
 # python3-matplotlib, as `fissure bench all` uses); the test skips (exit 77) without matplotlib.

@@ -103,9 +103,8 @@ TEST_P(PairedPlunge, NoCrossedNodesAndNoPenetrationAtAnySpeed) {
   EXPECT_LE(out.max_penetration_m, 1e-4);
   EXPECT_TRUE(out.forces_finite);
   EXPECT_TRUE(out.positions_finite);
-  // (Changed with the edge nodes: edge-first, the blade used to cut between the sphere's nodes
-  // with no contact and no force, and this test asserted only that its face nodes met the
-  // triangles; its rim nodes now push the surface in like any other tool.)
+  // (Without the edge nodes an edge-first blade cuts between the sphere's nodes with no contact
+  // and no force; its rim nodes push the surface in like any other tool.)
   EXPECT_GT(out.steps_in_contact, 0) << "the tool must actually hit the sphere";
   EXPECT_GT(out.max_force_n, 0.0);
   EXPECT_EQ(out.max_both_face_contacts, 0) << "pairing leaves at most one face of a pair pushing";
@@ -668,8 +667,8 @@ TEST(PairedCollision, PoseMatchedRestFrameFollowsTheBodyAndTheWorldFrameDoesNot)
 // the grip axis): each record's x is offset + n·(t − rest) along its triangle's plane, so its ẋ
 // can never be faster than the part moves, |Δp|/dt + |Δgap|/(2·dt). A triangle whose force plane
 // changes from one step to the next (its first colliding corner found now held on another plane,
-// round a rim) gave ẋ = Δx/dt across the switch before (hunt_crossley_force.cpp): in
-// clamp-sphere ~0.4 m/s of filtered ẋ on a jaw moving at cm/s.
+// round a rim) would give ẋ = Δx/dt across the switch if its filter were not restarted
+// (hunt_crossley_force.cpp): in clamp-sphere ~0.4 m/s of filtered ẋ on a jaw moving at cm/s.
 TEST(PairedCollision, NoRecordIndentsFasterThanItsPartMoves) {
   for (const char* name : {"spatula-sphere", "convex-spatula-sphere", "clamp-sphere", "clamp-vessel"}) {
     const SceneDescription scene = load_scene(resolve_scene_path(name));

@@ -403,8 +403,8 @@ TEST_P(PaperSceneProxy, RtEvaluationAtTheHostPoseIsWithinOnePercentOfTheHostForc
 // the host steps at the scene's rate (1 kHz) along its scripted trajectory, but rt_core only gets
 // every 10th proxy (a 100 Hz host, issue 6's 2 % row) through its own intake (take_latest_proxy,
 // with the plane extrapolation) and evaluates it at each 1 kHz step's pose and speed; the host's
-// own force at that step is the truth. A proxy frozen at its reference pose misses how the soft
-// body keeps moving under a still tool (measured: ~20 N/s on spatula-sphere after the press).
+// own force at that step is the truth. A proxy frozen at its reference pose misses whatever the
+// soft body does under a still tool between two proxies.
 struct HeldProxyError {
   double rms_n = 0.0;
   double peak_host_n = 0.0;

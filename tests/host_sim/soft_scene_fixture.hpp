@@ -30,7 +30,7 @@ namespace fissure::host::test_scene {
 
 inline constexpr double kSphereRadius_m = 0.05;  // paper / BRIEF §3: R = 5 cm
 inline constexpr int kSphereResolution = 63;     // CreateEllipsoid(.., 63) → 66 nodes, 128 faces (BRIEF §3)
-inline constexpr double kStep_s = 1e-3;          // 1 kHz host step (issue 5 tests)
+inline constexpr double kStep_s = 1e-3;          // 1 kHz host step
 
 class SoftWorld {
  public:

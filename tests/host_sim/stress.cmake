@@ -1,4 +1,4 @@
-# `fissure stress --profile ci` (issue 7): the numerical stability stress harness, every case
+# `fissure stress --profile ci`: the numerical stability stress harness, every case
 # shortened so the whole profile runs in CI in minutes (the full profile runs ≥ 1e6 rt ticks per
 # case and is run by hand: fissure stress --profile full). Labelled "stress": the default preset
 # runs it; the ASan preset leaves it out (it is a system test, and 5-10x slower there would

@@ -1,5 +1,5 @@
 #pragma once
-// SimFalcon: the Novint Falcon twin that CI and the lockstep sessions run against (issue 3).
+// SimFalcon: the Novint Falcon twin that CI and the lockstep sessions run against.
 // It implements HapticDevice with the Falcon's raw wire values, so rt_core cannot tell it
 // from the USB driver except by name() == "sim-falcon" (PX4's rule: only the leaf driver
 // changes between hardware and simulation).

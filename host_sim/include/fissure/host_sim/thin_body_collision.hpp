@@ -84,22 +84,12 @@ struct ThinBodyCollisionParams {
   // more than this: hysteresis against contact-set chatter when the soft body's own dynamics lift
   // a held node. Under normal_displacement its force share ramps (smoothstep) from 1 on the face
   // to 0 here, so this is also the width over which a separating node's force fades: 2 mm keeps
-  // the share's slope small against a held tool's ±40 µm encoder dither (0.2 mm, the former
-  // value, put ~7 N/mm of extra stiffness on the coarse ball: force steps of 15 % per dither step).
+  // the share's slope small against a held tool's ±40 µm encoder dither (0.2 mm puts ~7 N/mm
+  // of extra stiffness on the coarse ball: force steps of 15 % per dither step).
   double release_distance_m = 2.0e-3;
-  // Two off-by-default held-node options of earlier sessions were measured on bench collision's 32
-  // paired hold cells (tests/host_sim/hold_jitter_test.cpp) and on the tests, then deleted:
-  //  * retake_held_nodes — a held node pushed behind its plane (no tool node hitting it, its path
-  //    clear of the tool) put back on the face instead of released. On any plane within half a
-  //    thickness it changed clamp-sphere's squeeze (100 Hz proxy error 0.42 % -> 3.3 % of the
-  //    peak); restricted to rim planes it still leaves triangles sliced by a face-first plate's
-  //    rim (1 mm plate at 10 m/s with edge nodes: 3 at the end of the hold, 0 without);
-  //  * held_node_friction — Coulomb friction between a held node and the face (μ = kDF,
-  //    position-based) with an approach band made a slow press move the ball MORE (plate 1 mm
-  //    at 0.1 m/s: centre 13 mm aside at the end of the plunge vs 6 mm without, then squeezed
-  //    out from under the plate, force -> 0: hold jitter 2.9 % -> 146 %; blade 0.1 m/s 12 % ->
-  //    261 %) and the clamp-vessel proxy error went 1.27 % -> 6.0 % (bound 2 %).
-  // A held node behind its plane is released; the tool face is frictionless.
+  // A held node behind its plane is released, and the tool face is frictionless: putting such a
+  // node back on the face, or Coulomb friction between a held node and the face, make the bench's
+  // paired hold cells and the proxy tests worse (docs/decisions.md, "Held soft nodes").
   // ẋ is a finite difference of x filtered by a first-order low-pass with this cut-off
   // (time constant 1/(2π·fc), i.e. ≈1.6 ms lag at 100 Hz).
   double velocity_filter_cutoff_hz = 100.0;

@@ -12,8 +12,8 @@
 // even when the host's simulation clock is another machine's.
 //
 // Why extrapolate (optional, off by default — see ProxyExtrapolation for the measurement): when
-// the host's soft body keeps moving while the tool holds still (on spatula-sphere early in
-// session 2 the host force rose by ~20 N/s at a fixed tool pose after the press), a proxy frozen
+// the host's soft body keeps moving while the tool holds still (a host force rising by ~20 N/s
+// at a fixed tool pose after the press), a proxy frozen
 // at its reference pose is wrong by (force rate × host period) just before the next one arrives. Each patch's surface speed along its normal is
 // estimated from two consecutive proxies (matched by tool part and normal; host times from
 // the same host clock, so no clock mapping is needed), passed through a minmod limiter against
@@ -37,12 +37,10 @@ namespace fissure::rt {
 enum class ProxyIntake : std::uint8_t { kNothingNew, kAccepted, kRejected, kOutOfOrder };
 
 /// How patch planes are extrapolated between host updates (const model).
-/// Off by default: measured with the host as of the end of session 2 (`fissure bench proxy`,
-/// column extrap_v_h% against mdl_v_hst%; PaperSceneProxy held-proxy test), extrapolating made the
-/// held proxy slightly WORSE (spatula-sphere at a 100 Hz host: 0.68 % vs 0.49 % RMS; scripted
-/// trajectory: 0.378 % vs 0.292 %): that host's force no longer drifts at a still pose, and what
-/// the plane offset does between proxies is noise more than trend. Earlier in the session the host
-/// force crept by ~20 N/s at a still pose, which is what this was built for; keep it measured.
+/// Off by default: extrapolating makes the held proxy slightly WORSE (`fissure bench proxy`,
+/// column extrap_v_h% against mdl_v_hst%, and the PaperSceneProxy held-proxy test; figures in
+/// docs/decisions.md): the host's force does not drift at a still pose, and what the plane
+/// offset does between proxies is noise more than trend. Keep it measured.
 struct ProxyExtrapolation {
   bool enabled = false;
   /// Two patches of consecutive proxies are "the same contact" when they act on the same tool
