@@ -142,7 +142,7 @@ nlohmann::json run_bench(const BenchOptions& o) {
   // The step times are wall clock on a shared VM: the load says how loaded it was.
   out["load_average_start"] = load_average();
   const SceneDescription base = base_scene();
-  const double n_configured = base.hunt_crossley.exponent_n;
+  const double n_configured = base.hunt_crossley.n;
 
   // ---- 1. Tunnelling sweep. -------------------------------------------------------------
   if (o.runs("sweep")) {
@@ -208,7 +208,7 @@ nlohmann::json run_bench(const BenchOptions& o) {
     const double indent_hold_s = o.quick ? 0.03 : 0.08;
     constexpr double kConvergenceDepthM = 0.004;
     std::printf("\n2. Quasi-static force-indentation (paired, Hunt-Crossley n = %.2f, %s)\n", n_configured,
-                base.hunt_crossley.mode == host::HuntCrossleyMode::kPerUnitArea ? "per unit area" : "per triangle");
+                base.hunt_crossley.per_unit_area ? "per unit area" : "per triangle");
     // The finest sphere's curve includes the convergence depth: its convergence point is read off
     // that curve (one 20 480-face run instead of two — the finest mesh is most of the bench's time).
     double finest_force_at_depth_n = 0.0;
