@@ -7,13 +7,16 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include "fissure/host_sim/host_simulation.hpp"
 #include "fissure/host_sim/proxy_builder.hpp"
+#include "fissure/host_sim/proxy_model.hpp"
 #include "fissure/host_sim/scene_loader.hpp"
 #include "fissure/host_sim/soft_world.hpp"
 #include "fissure/viewer/frame_writer.hpp"
@@ -44,31 +47,6 @@ host::SceneCollisionMethod next_method(host::SceneCollisionMethod m) {
     case host::SceneCollisionMethod::kBullet: return host::SceneCollisionMethod::kPaired;
   }
   return host::SceneCollisionMethod::kPaired;
-}
-
-// The proxy builder's model for drawing the patches `fissure run` would send (the same jaw →
-// part rule as app/session_host.cpp's proxy_model_for). nullopt for the bullet method (no
-// contact records to build from).
-std::optional<host::ProxyBuilderModel> patch_model(const host::SceneDescription& scene, const host::HostSimulation& sim) {
-  host::ProxyBuilderModel model;
-  model.hunt_crossley.k = scene.hunt_crossley.stiffness_k;
-  model.hunt_crossley.lambda = scene.hunt_crossley.damping_lambda;
-  model.hunt_crossley.n = scene.hunt_crossley.exponent_n;
-  model.hunt_crossley.per_unit_area = scene.hunt_crossley.mode == host::HuntCrossleyMode::kPerUnitArea;
-  const bool clamp = scene.tool.kind == host::ToolKind::kClamp;
-  model.jaw_count = clamp ? 2 : 1;
-  const Eigen::Vector3d local_y_world = host::to_tool_pose(scene.trajectory.start).orientation_world * Eigen::Vector3d::UnitY();
-  for (int jaw = 0; jaw < model.jaw_count; ++jaw) {
-    const host::ToolNodes* nodes = sim.tool_nodes(jaw);
-    if (nodes == nullptr) return std::nullopt;
-    const auto j = static_cast<std::size_t>(jaw);
-    model.plane_count[j] = static_cast<int>(nodes->planes().size());
-    if (clamp) {
-      const double side = (jaw == 0 ? 1.0 : -1.0) * local_y_world[scene.device_mapping.closing_axis_world];
-      model.part_of_jaw[j] = side < 0.0 ? ToolPart::kJawA : ToolPart::kJawB;
-    }
-  }
-  return model;
 }
 
 // Half of the collidable part's extent along world y at the start orientation: the plunge
@@ -124,8 +102,9 @@ std::optional<host::SceneCollisionMethod> run_pass(const RenderOptions& o, const
     }
     on_model(*model);
   }
+  // The patches `fissure run` would send; none for the bullet method (no contact records).
   std::optional<host::ProxyBuilder> builder;
-  if (auto m = patch_model(scene, *sim)) builder.emplace(*m);
+  if (auto m = host::proxy_model_for(scene, *sim)) builder.emplace(*m);
   ContactProxy proxy{};
   host::ProxyPartMotion motion;
   std::array<Eigen::Vector3d, host::kMaxToolParts> previous_part_p{};
@@ -302,7 +281,9 @@ void register_render(CommandTree& tree) {
   auto json_path = std::make_shared<std::string>();
   CLI::App* cmd = tree.root.add_subcommand("render", "Draw a scene's host simulation: PNG frames headlessly (--frames) and/or a live window (--view)");
   cmd->add_option("scene", o->scene, "Scene name (scenes/NAME.toml) or path to a scene file")->required();
-  cmd->add_option("--method", *method, "Collision method: paired | ray | bullet (default: the scene's)")->check(CLI::IsMember({"paired", "ray", "bullet"}));
+  std::vector<std::string> method_names;
+  for (const host::SceneCollisionMethod m : host::kCollisionMethods) method_names.emplace_back(host::to_string(m));
+  cmd->add_option("--method", *method, "Collision method: paired | ray | bullet (default: the scene's)")->check(CLI::IsMember(method_names));
   cmd->add_option("--seconds", o->seconds, "Simulated seconds (default: the trajectory's or plunge's length)")->check(CLI::PositiveNumber);
   cmd->add_option("--settle-seconds", o->settle_seconds, "Let the soft body settle under gravity first [s]")->check(CLI::NonNegativeNumber);
   cmd->add_option("--plunge", o->plunge_speed_m_per_s, "Replace the trajectory by a straight plunge at this speed [m/s] (bench collision's sweep: 15 mm above to 20 mm below the top)")
@@ -324,11 +305,7 @@ void register_render(CommandTree& tree) {
   cmd->add_option("--json", *json_path, "Write the timings summary JSON here");
   cmd->callback([o, method, json_path] {
     RenderOptions options = *o;
-    if (!method->empty()) {
-      options.method = *method == "paired" ? host::SceneCollisionMethod::kPaired
-                       : *method == "ray"  ? host::SceneCollisionMethod::kRay
-                                           : host::SceneCollisionMethod::kBullet;
-    }
+    if (!method->empty()) options.method = host::parse_collision_method(*method);  // IsMember checked the name
     std::sort(options.frame_at_s.begin(), options.frame_at_s.end());
     const RenderOutcome r = run_render(options);
     print_summary(options, r);

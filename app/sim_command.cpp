@@ -76,9 +76,7 @@ struct SimOptions {
 
 std::optional<host::SceneCollisionMethod> parse_method(const std::string& name) {
   if (name.empty()) return std::nullopt;
-  if (name == "paired") return host::SceneCollisionMethod::kPaired;
-  if (name == "ray") return host::SceneCollisionMethod::kRay;
-  if (name == "bullet") return host::SceneCollisionMethod::kBullet;
+  if (const auto method = host::parse_collision_method(name)) return method;
   throw CLI::ValidationError("--method", "must be paired, ray or bullet (got '" + name + "')");
 }
 

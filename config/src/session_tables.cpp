@@ -82,12 +82,7 @@ void read_hand(const std::string& file, TableReader& t, HandScript& hand) {
 }
 
 RtSessionConfig load_rt_session_config_text(std::string_view toml_text, const std::string& file_label) {
-  toml::table root;
-  try {
-    root = toml::parse(toml_text, file_label);
-  } catch (const toml::parse_error& e) {
-    throw SceneError(file_label, static_cast<int>(e.source().begin.line), "", "TOML syntax error: " + std::string(e.description()));
-  }
+  const toml::table root = parse_toml(toml_text, file_label);
   RtSessionConfig config;
   config.scene_name = std::filesystem::path(file_label).stem().string();
   TableReader top(file_label, root, "");
@@ -103,11 +98,7 @@ RtSessionConfig load_rt_session_config_text(std::string_view toml_text, const st
 }
 
 RtSessionConfig load_rt_session_config(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw SceneError(file.string(), 0, "", "cannot open the scene file");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return load_rt_session_config_text(buffer.str(), file.string());
+  return load_rt_session_config_text(read_config_file(file), file.string());
 }
 
 std::filesystem::path find_scenes_dir() {

@@ -1,5 +1,7 @@
 #include "fissure/config/table_reader.hpp"
 
+#include <fstream>
+
 namespace fissure::config {
 
 namespace {
@@ -29,6 +31,22 @@ std::string unit_name(const std::string& suffix) {
       {"kpr", "Bullet's kPR coefficient"}, {"kvc", "Bullet's kVC coefficient"}};
   const auto it = kNames.find(suffix);
   return it == kNames.end() ? "'" + suffix + "'" : it->second;
+}
+
+std::string read_config_file(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw SceneError(file.string(), 0, "", "cannot open the scene file");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+toml::table parse_toml(std::string_view text, const std::string& file_label) {
+  try {
+    return toml::parse(text, file_label);
+  } catch (const toml::parse_error& e) {
+    throw SceneError(file_label, static_cast<int>(e.source().begin.line), "", "TOML syntax error: " + std::string(e.description()));
+  }
 }
 
 std::string child_path(const TableReader& parent, const std::string& key) {

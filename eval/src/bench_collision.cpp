@@ -186,9 +186,9 @@ void run_sweep(const BenchCollisionOptions& o, nlohmann::json& out) {
 // convergence table reads its point off the curve (one 20 480-face run instead of two — the
 // finest mesh is most of the bench's time).
 double run_indentation(const SceneDescription& base, const std::vector<int>& mesh_faces, double indent_hold_s, nlohmann::json& out) {
-  const double n_configured = base.hunt_crossley.exponent_n;
+  const double n_configured = base.hunt_crossley.n;
   std::printf("\n2. Quasi-static force-indentation (paired, Hunt-Crossley n = %.2f, %s)\n", n_configured,
-              base.hunt_crossley.mode == host::HuntCrossleyMode::kPerUnitArea ? "per unit area" : "per triangle");
+              base.hunt_crossley.per_unit_area ? "per unit area" : "per triangle");
   double finest_force_at_depth_n = 0.0;
   SceneDescription slab = base;
   host::SoftSlab shape;

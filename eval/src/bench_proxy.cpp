@@ -35,6 +35,7 @@
 
 #include "fissure/eval/eval_error.hpp"
 #include "fissure/falcon_hw/sim_falcon.hpp"
+#include "fissure/host_sim/proxy_model.hpp"
 #include "fissure/host_sim/scene_loader.hpp"
 #include "fissure/shared/device_mapping.hpp"
 #include "fissure/rt_core/hunt_crossley.hpp"
@@ -120,7 +121,7 @@ RunResult run_once(const host::SceneDescription& scene, const rt::RtModel& model
                    LockstepClock& clock, int ticks_per_host, std::size_t ticks, double settle_s) {
   SessionHost host(scene);
   host.settle(settle_s);
-  const host::ProxyBuilderModel parts_model = proxy_model_for(scene, host.simulation());
+  const host::ProxyBuilderModel parts_model = host::proxy_model_for(scene, host.simulation()).value();  // SessionHost checked it
   RtStack rt(model, device, clock);
   rt::RtLoop& loop = rt.loop();
   RtChannels& channels = rt.channels();
@@ -237,7 +238,6 @@ struct Decomposition {
   double model_rms_pct = 0.0, model_peak_pct = 0.0;
   double host_divergence_rms_pct = 0.0, host_divergence_peak_pct = 0.0;
   double model_vs_host_rms_pct = 0.0, model_vs_host_peak_pct = 0.0;
-  double other_model_vs_host_rms_pct = 0.0;  // the same with the plane extrapolation switched the other way
   double oracle_vs_host_rms_pct = 0.0;
   double max_dforce_unblended_n = 0.0;  // per-tick step of P_row (what the device would get without the blend)
   double max_dforce_swap_n = 0.0;       // rendered step on ticks where a new proxy was taken
@@ -246,39 +246,32 @@ struct Decomposition {
   // the proxy in use at j (as rendered at j). This is the stiffness being rendered at the encoder's resolution; the
   // swap/blend cannot remove it.
   double max_dforce_motion_n = 0.0;
-  // What is left of each rendered step once the motion step is taken out: the swap/blend's share
-  // (plus the plane extrapolation's per-tick drift).
+  // What is left of each rendered step once the motion step is taken out: the swap/blend's share.
   double max_dforce_swap_share_n = 0.0;
 };
 
-// rt_core's own proxy intake (take_latest_proxy: validation, plane extrapolation) replayed
+// rt_core's own proxy intake (take_latest_proxy: validation, ordering) replayed
 // outside the loop, fed a chosen proxy on the ticks where `run` took a new one: gives, per tick,
 // the proxy the tick evaluated (or would have, for the oracle's proxies on the row's schedule).
 class ProxyReplay {
  public:
-  explicit ProxyReplay(bool extrapolate = rt::ProxyExtrapolation{}.enabled)
-      : exchange_(std::make_unique<ProxyExchange>()), state_(std::make_unique<rt::ProxyState>()) {
-    extrapolation_.enabled = extrapolate;
-  }
+  ProxyReplay() : exchange_(std::make_unique<ProxyExchange>()), state_(std::make_unique<rt::ProxyState>()) {}
   const ContactProxy* at(const ContactProxy* incoming, TimeNs now_ns) {
     if (incoming != nullptr) exchange_->publish(*incoming);
-    rt::take_latest_proxy(*exchange_, *state_, now_ns, extrapolation_);
+    rt::take_latest_proxy(*exchange_, *state_, now_ns);
     return state_->have_proxy ? &rt::active_proxy(*state_) : nullptr;
   }
 
  private:
   std::unique_ptr<ProxyExchange> exchange_;
   std::unique_ptr<rt::ProxyState> state_;
-  rt::ProxyExtrapolation extrapolation_;
 };
 
 // Per tick of `run`: its own proxy as rendered before the blend (fade applied), the oracle's
 // proxy from the same host tick run through the same intake, and the motion step (the proxy in
 // use at tick j evaluated at pose j minus at pose j−1).
-// oracle_same_other: the same with rt_core's plane extrapolation switched the other way from
-// its default (ProxyExtrapolation) — the model A/B on one and the same host run.
 struct ReplayedForces {
-  std::vector<Eigen::Vector3d> unblended, oracle_same, oracle_same_other, motion;
+  std::vector<Eigen::Vector3d> unblended, oracle_same, motion;
 };
 
 ReplayedForces replay_proxies(const RunResult& run, const RunResult& oracle, const DeviceMapping& mapping) {
@@ -287,10 +280,8 @@ ReplayedForces replay_proxies(const RunResult& run, const RunResult& oracle, con
   out.unblended.assign(n, Eigen::Vector3d::Zero());
   out.oracle_same.assign(n, Eigen::Vector3d::Zero());
   out.motion.assign(n, Eigen::Vector3d::Zero());
-  out.oracle_same_other.assign(n, Eigen::Vector3d::Zero());
   ProxyReplay own;
   ProxyReplay same;
-  ProxyReplay same_other(!rt::ProxyExtrapolation{}.enabled);
   std::uint64_t last_sequence = 0;
   for (std::size_t j = 0; j < n; ++j) {
     const std::uint64_t sequence = run.proxy_sequence[j];
@@ -304,10 +295,6 @@ ReplayedForces replay_proxies(const RunResult& run, const RunResult& oracle, con
     last_sequence = sequence;
     const ContactProxy* own_proxy = own.at(own_in, run.tick_time_ns[j]);
     const ContactProxy* same_proxy = same.at(same_in, run.tick_time_ns[j]);
-    const ContactProxy* other_proxy = same_other.at(same_in, run.tick_time_ns[j]);
-    if (other_proxy != nullptr) {
-      out.oracle_same_other[j] = run.fade_gain[j] * raw_proxy_force(*other_proxy, mapping, run.tool[j]);
-    }
     if (own_proxy != nullptr) {
       out.unblended[j] = run.fade_gain[j] * raw_proxy_force(*own_proxy, mapping, run.tool[j]);
       if (j > 0) out.motion[j] = out.unblended[j] - run.fade_gain[j] * raw_proxy_force(*own_proxy, mapping, run.tool[j - 1]);
@@ -319,7 +306,7 @@ ReplayedForces replay_proxies(const RunResult& run, const RunResult& oracle, con
 
 Decomposition decompose(const RunResult& run, const RunResult& oracle, const DeviceMapping& mapping,
                         double peak_oracle_n) {
-  ErrorAccumulator blend, divergence, model, host_divergence, model_vs_host, oracle_vs_host, other_vs_host;
+  ErrorAccumulator blend, divergence, model, host_divergence, model_vs_host, oracle_vs_host;
   Decomposition d;
   const ReplayedForces replayed = replay_proxies(run, oracle, mapping);
   const std::size_t n = replayed.unblended.size();
@@ -332,7 +319,6 @@ Decomposition decompose(const RunResult& run, const RunResult& oracle, const Dev
     // The oracle's host stepped to every tick's pose: host_force_n[j] is its force at tick j.
     if (j < oracle.host_force_n.size()) {
       model_vs_host.add(oracle_same - oracle.host_force_n[j]);
-      other_vs_host.add(replayed.oracle_same_other[j] - oracle.host_force_n[j]);
       oracle_vs_host.add(oracle.contact_force_n[j] - oracle.host_force_n[j]);
     }
     if (j > 0) {
@@ -362,7 +348,6 @@ Decomposition decompose(const RunResult& run, const RunResult& oracle, const Dev
   d.model_vs_host_rms_pct = model_vs_host.rms_pct(peak_oracle_n);
   d.model_vs_host_peak_pct = model_vs_host.peak_pct(peak_oracle_n);
   d.oracle_vs_host_rms_pct = oracle_vs_host.rms_pct(peak_oracle_n);
-  d.other_model_vs_host_rms_pct = other_vs_host.rms_pct(peak_oracle_n);
   return d;
 }
 
@@ -439,9 +424,9 @@ nlohmann::json run_proxy_bench(const BenchProxyOptions& options) {
               base.name.c_str(), options.rt_rate_hz, duration_s, ticks, peak_oracle);
   std::printf("oracle replay (host every tick) vs oracle: rms %.3g %%, peak %.3g %% (determinism check)\n",
               self_error.rms_pct, self_error.peak_pct);
-  std::printf("%8s %14s %15s %13s %17s %12s %12s | %9s %9s %9s %9s %9s %11s | %9s %9s %9s %9s %9s\n", "host_hz", "rms_error_pct",
+  std::printf("%8s %14s %15s %13s %17s %12s %12s | %9s %9s %9s %9s %9s | %9s %9s %9s %9s %9s\n", "host_hz", "rms_error_pct",
               "peak_error_pct", "max_dforce_n", "host_cpu_s_per_s", "step_ms_med", "step_ms_p99", "blend%", "diverge%",
-              "model%", "host_div%", "mdl_v_hst%", rt::ProxyExtrapolation{}.enabled ? "frozen_v_h%" : "extrap_v_h%", "dF_swap", "dF_betw", "dF_unbl", "dF_motion", "dF_blend");
+              "model%", "host_div%", "mdl_v_hst%", "dF_swap", "dF_betw", "dF_unbl", "dF_motion", "dF_blend");
   nlohmann::json rows = nlohmann::json::array();
   const DeviceMapping& mapping = model.config.mapping;
   const auto add_row = [&](double host_hz, RunResult& run) {
@@ -449,10 +434,9 @@ nlohmann::json run_proxy_bench(const BenchProxyOptions& options) {
     const Decomposition d = decompose(run, oracle, mapping, peak_oracle);
     const Quantiles q = quantiles(run.host_step_ms);
     const double cpu_per_s = run.host_cpu_s / run.simulated_s;
-    std::printf("%8.0f %14.3f %15.3f %13.4f %17.3f %12.3f %12.3f | %9.3f %9.3f %9.3f %9.3f %9.3f %11.3f | %9.4f %9.4f %9.4f %9.4f %9.4f\n",
+    std::printf("%8.0f %14.3f %15.3f %13.4f %17.3f %12.3f %12.3f | %9.3f %9.3f %9.3f %9.3f %9.3f | %9.4f %9.4f %9.4f %9.4f %9.4f\n",
                 host_hz, e.rms_pct, e.peak_pct, e.max_dforce_n, cpu_per_s, q.median, q.p99, d.blend_rms_pct,
                 d.divergence_rms_pct, d.model_rms_pct, d.host_divergence_rms_pct, d.model_vs_host_rms_pct,
-                d.other_model_vs_host_rms_pct,
                 d.max_dforce_swap_n, d.max_dforce_between_n, d.max_dforce_unblended_n, d.max_dforce_motion_n,
                 d.max_dforce_swap_share_n);
     rows.push_back({{"host_hz", host_hz},
@@ -473,9 +457,6 @@ nlohmann::json run_proxy_bench(const BenchProxyOptions& options) {
                       {"host_divergence_peak_pct", d.host_divergence_peak_pct},
                       {"model_vs_host_rms_pct", d.model_vs_host_rms_pct},
                       {"model_vs_host_peak_pct", d.model_vs_host_peak_pct},
-                      {rt::ProxyExtrapolation{}.enabled ? "model_vs_host_without_extrapolation_rms_pct"
-                                                        : "model_vs_host_with_extrapolation_rms_pct",
-                       d.other_model_vs_host_rms_pct},
                       {"max_dforce_swap_n", d.max_dforce_swap_n},
                       {"max_dforce_between_swaps_n", d.max_dforce_between_n},
                       {"max_dforce_unblended_n", d.max_dforce_unblended_n},
@@ -523,7 +504,6 @@ nlohmann::json run_proxy_bench(const BenchProxyOptions& options) {
       {"model", "oracle's proxy from the row's host tick, evaluated up to one host period later - oracle's rendered force"},
       {"host_divergence", "row host force at its steps - oracle host force at the same tick"},
       {"model_vs_host", "oracle's proxy from the row's host tick at the tick's pose - oracle host's own force at that pose"},
-      {"model_vs_host_with(out)_extrapolation", "the same with rt_core's plane extrapolation (rt::ProxyExtrapolation) switched the other way from its default"},
       {"note", "blend + divergence + model = rendered - oracle exactly (per tick, as vectors); all % of the oracle's peak |F|"}};
   out["targets"] = {{"rms_error_pct_at_100_hz", 2.0}, {"rms_error_pct_at_1000_hz", 0.5}, {"max_dforce_n", 0.05}};
   out["rows"] = rows;

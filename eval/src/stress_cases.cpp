@@ -254,8 +254,8 @@ void add_parameter_cases(std::vector<StressCase>& cases) {
     char name[64];
     std::snprintf(name, sizeof name, "hc_k_%.0e", k);
     cases.push_back({name, g, scene, 1000.0, [k](StressSetup& s, std::uint64_t seed) {
-                       s.scene.hunt_crossley.stiffness_k = k;
-                       s.scene.hunt_crossley.damping_lambda = 0.1 * k;  // the scene's λ/k = 0.1 s/m
+                       s.scene.hunt_crossley.k = k;
+                       s.scene.hunt_crossley.lambda = 0.1 * k;  // the scene's λ/k = 0.1 s/m
                        random_hand(s, HandStyle::kRandom, seed);
                      }});
   }
@@ -266,9 +266,9 @@ void add_parameter_cases(std::vector<StressCase>& cases) {
     std::snprintf(name, sizeof name, "hc_n_%.2f", n);
     cases.push_back({name, g, scene, 1000.0, [n](StressSetup& s, std::uint64_t seed) {
                        const double k = 1e7 * std::pow(0.005, 1.5 - n);
-                       s.scene.hunt_crossley.exponent_n = n;
-                       s.scene.hunt_crossley.stiffness_k = k;
-                       s.scene.hunt_crossley.damping_lambda = 0.1 * k;
+                       s.scene.hunt_crossley.n = n;
+                       s.scene.hunt_crossley.k = k;
+                       s.scene.hunt_crossley.lambda = 0.1 * k;
                        random_hand(s, HandStyle::kRandom, seed);
                      }});
   }
@@ -278,7 +278,7 @@ void add_parameter_cases(std::vector<StressCase>& cases) {
     char name[64];
     std::snprintf(name, sizeof name, "hc_lambda_over_k_%g", ratio);
     cases.push_back({name, g, scene, 1000.0, [ratio](StressSetup& s, std::uint64_t seed) {
-                       s.scene.hunt_crossley.damping_lambda = ratio * s.scene.hunt_crossley.stiffness_k;
+                       s.scene.hunt_crossley.lambda = ratio * s.scene.hunt_crossley.k;
                        random_hand(s, HandStyle::kFlicks, seed);
                      }});
   }

@@ -50,7 +50,6 @@ void validate(const SimFalconConfig& config) {
   const SimDynamicsConfig& dynamics = config.dynamics;
   require_positive(dynamics.effective_mass_kg, "dynamics.effective_mass_kg");
   require_non_negative(dynamics.viscous_damping_n_s_per_m, "dynamics.viscous_damping_n_s_per_m");
-  require_finite(dynamics.gravity_device_m_per_s2, "dynamics.gravity_device_m_per_s2");
   require_positive(dynamics.physics_rate_hz, "dynamics.physics_rate_hz");
   if (dynamics.physics_rate_hz > 1e8) reject("dynamics.physics_rate_hz", "<= 1e8 (10 ns sub-steps)", dynamics.physics_rate_hz);
   require_positive(dynamics.max_catch_up_s, "dynamics.max_catch_up_s");
@@ -200,8 +199,7 @@ void SimFalcon::sub_step(TimeNs h_ns) noexcept {
             : Eigen::Vector3d::Zero();
   const Eigen::Vector3d end_stop_force_n = end_stop_force(p, v);
   const double mass_kg = dynamics.effective_mass_kg;
-  const Eigen::Vector3d applied_n =
-      motor_force_n + hand_force_n + end_stop_force_n + mass_kg * as_eigen(dynamics.gravity_device_m_per_s2);
+  const Eigen::Vector3d applied_n = motor_force_n + hand_force_n + end_stop_force_n;
 
   // Exact solution of m·v' = F − b·v over the step with F held constant; p semi-implicit.
   const double b = dynamics.viscous_damping_n_s_per_m;

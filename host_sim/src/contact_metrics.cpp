@@ -191,7 +191,7 @@ CrossingSnapshot CrossingTracker::update(const std::vector<Eigen::Vector3d>& sof
     // slide past the mid-plane along the face — that is going round the rim, not through.
     const bool beside_rim = !inside && penetration_m == 0.0 && std::abs(p.y()) < volume_.half_thickness_m();
     const bool in_footprint = volume_.in_footprint(p) && !beside_rim;
-    // The previous rule (end point only), kept as a comparison figure.
+    // The end-point-only rule, kept as a comparison figure.
     const bool endpoint_wrong_side = follow_side(endpoint_side_[i], side_now, in_footprint);
     snap.endpoint_crossed_nodes += (endpoint_wrong_side || inside) ? 1 : 0;
     // The path since the last update: round the rim → the memory follows to the new side;

@@ -78,13 +78,7 @@ HostSimulation::HostSimulation(const SceneDescription& scene, std::optional<Scen
   }
   if (!bullet) {
     ThinBodyCollisionParams params;
-    params.hunt_crossley.k = scene_.hunt_crossley.stiffness_k;
-    params.hunt_crossley.lambda = scene_.hunt_crossley.damping_lambda;
-    params.hunt_crossley.n = scene_.hunt_crossley.exponent_n;
-    params.hunt_crossley.per_unit_area = scene_.hunt_crossley.mode == HuntCrossleyMode::kPerUnitArea;
-    params.hunt_crossley.measure = scene_.hunt_crossley.deformation_measure == DeformationMeasureKind::kCentroidDistance
-                                       ? DeformationMeasure::kCentroidDistance
-                                       : DeformationMeasure::kNormalDisplacement;
+    params.hunt_crossley = scene_.hunt_crossley;
     for (int p = 0; p < parts; ++p) {
       params.jaw = p;
       const ToolNodes& nodes = tool_nodes_[static_cast<std::size_t>(p)];

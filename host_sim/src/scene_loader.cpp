@@ -38,6 +38,13 @@ const char* to_string(SceneCollisionMethod method) noexcept {
   return "?";
 }
 
+std::optional<SceneCollisionMethod> parse_collision_method(std::string_view name) noexcept {
+  for (const SceneCollisionMethod method : kCollisionMethods) {
+    if (name == to_string(method)) return method;
+  }
+  return std::nullopt;
+}
+
 namespace {
 
 using config::child_path;
@@ -50,9 +57,9 @@ void read_simulation(TableReader& t, SimulationDescription& sim) {
   sim.time_step_s = t.in_range("time_step", "s", 1e-6, 0.1);
   sim.substeps_count = t.count("substeps", 1, 1000);
   sim.gravity_world_m_per_s2 = t.vec3("gravity_world", "m_per_s2");
-  sim.collision_method = t.choice<SceneCollisionMethod>(
-      "collision_method",
-      {{"paired", SceneCollisionMethod::kPaired}, {"ray", SceneCollisionMethod::kRay}, {"bullet", SceneCollisionMethod::kBullet}});
+  std::vector<std::pair<std::string, SceneCollisionMethod>> methods;
+  for (const SceneCollisionMethod method : kCollisionMethods) methods.emplace_back(to_string(method), method);
+  sim.collision_method = t.choice<SceneCollisionMethod>("collision_method", methods);
   t.finish();
 }
 
@@ -207,19 +214,19 @@ void read_tool(const std::string& file, TableReader& t, ToolDescription& tool, c
   t.finish();
 }
 
-void read_hunt_crossley(TableReader& t, HuntCrossleyDescription& hc) {
-  hc.mode = t.choice<HuntCrossleyMode>("mode", {{"per_unit_area", HuntCrossleyMode::kPerUnitArea}, {"per_triangle", HuntCrossleyMode::kPerTriangle}});
-  hc.deformation_measure = t.choice<DeformationMeasureKind>(
+void read_hunt_crossley(TableReader& t, HuntCrossleyParams& hc) {
+  hc.per_unit_area = t.choice<bool>("mode", {{"per_unit_area", true}, {"per_triangle", false}});
+  hc.measure = t.choice<DeformationMeasure>(
       "deformation_measure",
-      {{"normal_displacement", DeformationMeasureKind::kNormalDisplacement}, {"centroid_distance", DeformationMeasureKind::kCentroidDistance}},
-      DeformationMeasureKind::kNormalDisplacement);
-  hc.exponent_n = t.in_range("exponent", "n", 0.5, 3.0);
-  if (hc.mode == HuntCrossleyMode::kPerUnitArea) {
-    hc.stiffness_k = t.in_range("stiffness", "pa_per_m_pow_n", 0.0, 1e30);
-    hc.damping_lambda = t.in_range("damping", "pa_s_per_m_pow_n_plus_1", 0.0, 1e30);
+      {{"normal_displacement", DeformationMeasure::kNormalDisplacement}, {"centroid_distance", DeformationMeasure::kCentroidDistance}},
+      DeformationMeasure::kNormalDisplacement);
+  hc.n = t.in_range("exponent", "n", 0.5, 3.0);
+  if (hc.per_unit_area) {
+    hc.k = t.in_range("stiffness", "pa_per_m_pow_n", 0.0, 1e30);
+    hc.lambda = t.in_range("damping", "pa_s_per_m_pow_n_plus_1", 0.0, 1e30);
   } else {
-    hc.stiffness_k = t.in_range("stiffness", "n_per_m_pow_n", 0.0, 1e30);
-    hc.damping_lambda = t.in_range("damping", "n_s_per_m_pow_n_plus_1", 0.0, 1e30);
+    hc.k = t.in_range("stiffness", "n_per_m_pow_n", 0.0, 1e30);
+    hc.lambda = t.in_range("damping", "n_s_per_m_pow_n_plus_1", 0.0, 1e30);
   }
   t.finish();
 }
@@ -298,21 +305,11 @@ SceneDescription parse(const toml::table& root, const std::string& file, const s
 }  // namespace
 
 SceneDescription load_scene_text(std::string_view toml_text, const std::string& file_label, const std::filesystem::path& base_dir) {
-  toml::table root;
-  try {
-    root = toml::parse(toml_text, file_label);
-  } catch (const toml::parse_error& e) {
-    throw SceneError(file_label, static_cast<int>(e.source().begin.line), "", "TOML syntax error: " + std::string(e.description()));
-  }
-  return parse(root, file_label, base_dir);
+  return parse(config::parse_toml(toml_text, file_label), file_label, base_dir);
 }
 
 SceneDescription load_scene(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw SceneError(file.string(), 0, "", "cannot open the scene file");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return load_scene_text(buffer.str(), file.string(), file.parent_path());
+  return load_scene_text(config::read_config_file(file), file.string(), file.parent_path());
 }
 
 Quat quat_from_rpy_deg(const Vec3& rpy_deg) {

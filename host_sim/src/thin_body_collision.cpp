@@ -105,8 +105,8 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision {
     return put_out_nodes_inside(previous, current, soft);
   }
 
-  [[nodiscard]] CollisionMethod method() const override {
-    return model_.paired ? CollisionMethod::kPaired : CollisionMethod::kRay;
+  [[nodiscard]] SceneCollisionMethod method() const override {
+    return model_.paired ? SceneCollisionMethod::kPaired : SceneCollisionMethod::kRay;
   }
 
  private:

@@ -22,7 +22,7 @@ void close_recovery_window(PassivityState& state) noexcept {
 /// What the reduction g does not act on: the closed windows' forgiven work plus the open one's,
 /// but never more than E stands above the reference −margin — forgiven work that the damper
 /// (or the hand) has since dissipated is no longer owed. (Without this bound the forgiveness
-/// of every past fault added up — 4 mJ × 18 faults — and g stopped acting at all.)
+/// of every past fault adds up — 4 mJ × 18 faults — and g stops acting at all.)
 double forgiven_j(const PassivityState& state, double margin_j) noexcept {
   const double owed_j =
       state.recovery_forgiven_j + std::clamp(state.recovery_window_energy_j, 0.0, kPassivityRecoveryForgiveness_j);

@@ -28,7 +28,7 @@ Eigen::Vector3d blend(BlendState& state, const Eigen::Vector3d& new_force_device
     // the tool's motion under the proxy in use (at a swap: under the old one, begin_swap having
     // made new + offset = old at this pose).
     // A non-finite force (which safety turns into a fault) must not poison the offset for good:
-    // without a usable motion step the walk takes the plain bound, as it did before session 4.
+    // without a usable motion step the walk takes the plain bound.
     Eigen::Vector3d motion_step = Eigen::Vector3d::Zero();
     if (state.have_last_output) motion_step = new_force_device_n + state.offset_device_n - state.last_output_device_n;
     if (!motion_step.allFinite()) motion_step.setZero();

@@ -92,7 +92,8 @@ RtEndOutcome run_rt_end(const RtEndOptions& options) {
     if (interrupted(options)) stop_rt.store(true);
     while (channels.telemetry.try_pop(sample)) {
       outcome.force_max_n = std::max(outcome.force_max_n, as_eigen(sample.force_device_n).norm());
-      if ((sample.fault_bits & rt::kAnyFault) != 0) ++outcome.fault_ticks;
+      if ((sample.fault_bits & rt::kDeviceSideFaults) != 0) ++outcome.device_fault_ticks;
+      if ((sample.fault_bits & rt::kFaultProxyStale) != 0) ++outcome.proxy_stale_ticks;
       if (sample.proxy_sequence != last_proxy_sequence) {
         ++outcome.proxies_used;
         last_proxy_sequence = sample.proxy_sequence;
@@ -143,14 +144,17 @@ RtEndOutcome run_rt_end(const RtEndOptions& options) {
   outcome.frames_discarded = link.frames_discarded;
   outcome.messages_discarded = link.messages_discarded;
   outcome.host_restarts = link.peer_restarts;
+  outcome.proxies_rejected = rt.loop().data().proxy.rejected_count;
   outcome.interrupted = interrupted(options);
   std::printf("%s: %.2f s, %llu ticks, overruns %llu | link %s | proxies used %llu | force max %.2f N | "
-              "discards %llu frames / %llu msgs | host restarts %llu | fault ticks %llu%s\n",
+              "discards %llu frames / %llu msgs | host restarts %llu | device fault ticks %llu | proxies rejected %llu | "
+              "stale-proxy ticks %llu%s\n",
               options.program, outcome.seconds, static_cast<unsigned long long>(outcome.ticks),
               static_cast<unsigned long long>(outcome.overruns), outcome.link_established ? "established" : "never established",
               static_cast<unsigned long long>(outcome.proxies_used), outcome.force_max_n,
               static_cast<unsigned long long>(outcome.frames_discarded), static_cast<unsigned long long>(outcome.messages_discarded),
-              static_cast<unsigned long long>(outcome.host_restarts), static_cast<unsigned long long>(outcome.fault_ticks),
+              static_cast<unsigned long long>(outcome.host_restarts), static_cast<unsigned long long>(outcome.device_fault_ticks),
+              static_cast<unsigned long long>(outcome.proxies_rejected), static_cast<unsigned long long>(outcome.proxy_stale_ticks),
               outcome.interrupted ? " | stopped by Ctrl-C" : "");
   std::fflush(stdout);
   if (link.failed) throw SessionError(link.error);

@@ -5,10 +5,12 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 
 #include <BulletSoftBody/btSoftBody.h>
 
+#include "fissure/host_sim/proxy_model.hpp"
 #include "fissure/host_sim/soft_world.hpp"
 #include "fissure/shared/device_mapping.hpp"
 
@@ -19,40 +21,19 @@ static_assert(host::kMaxProxyJaws == host::kMaxToolParts, "one proxy-builder jaw
 
 Eigen::Quaterniond to_quaternion(const Quat& q) { return Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized(); }
 
-}  // namespace
-
-host::ProxyBuilderModel proxy_model_for(const host::SceneDescription& scene, const host::HostSimulation& sim) {
-  host::ProxyBuilderModel model;
-  model.hunt_crossley.k = scene.hunt_crossley.stiffness_k;
-  model.hunt_crossley.lambda = scene.hunt_crossley.damping_lambda;
-  model.hunt_crossley.n = scene.hunt_crossley.exponent_n;
-  model.hunt_crossley.per_unit_area = scene.hunt_crossley.mode == host::HuntCrossleyMode::kPerUnitArea;
-  const bool clamp = scene.tool.kind == host::ToolKind::kClamp;
-  model.jaw_count = clamp ? 2 : 1;
-  // rt_core's clamp convention (rt_core/device_mapping.hpp): jaw A is the one on the −e_c side.
-  // host_sim's jaw 0 sits at tool-local +y (host_simulation.hpp); the tool keeps its start
-  // orientation throughout a session.
-  const Eigen::Vector3d local_y_world = to_quaternion(scene.trajectory.start.orientation_world) * Eigen::Vector3d::UnitY();
-  for (int jaw = 0; jaw < model.jaw_count; ++jaw) {
-    const auto j = static_cast<std::size_t>(jaw);
-    const host::ToolNodes* nodes = sim.tool_nodes(jaw);
-    if (nodes == nullptr) {
-      throw std::invalid_argument("scene '" + scene.name +
-                                  "': fissure run needs the paired or ray collision method (the proxy is built from its contacts)");
-    }
-    model.plane_count[j] = static_cast<int>(nodes->planes().size());
-    if (clamp) {
-      const double side = (jaw == 0 ? 1.0 : -1.0) * local_y_world[scene.device_mapping.closing_axis_world];
-      model.part_of_jaw[j] = side < 0.0 ? ToolPart::kJawA : ToolPart::kJawB;
-    } else {
-      model.part_of_jaw[j] = ToolPart::kTool;
-    }
+host::ProxyBuilderModel session_proxy_model(const host::SceneDescription& scene, const host::HostSimulation& sim) {
+  std::optional<host::ProxyBuilderModel> model = host::proxy_model_for(scene, sim);
+  if (!model) {
+    throw std::invalid_argument("scene '" + scene.name +
+                                "': fissure run needs the paired or ray collision method (the proxy is built from its contacts)");
   }
-  return model;
+  return *model;
 }
 
+}  // namespace
+
 SessionHost::SessionHost(const host::SceneDescription& scene)
-    : scene_(scene), sim_(scene), builder_(proxy_model_for(scene, sim_)) {
+    : scene_(scene), sim_(scene), builder_(session_proxy_model(scene, sim_)) {
   pose_.position_world_m = as_eigen(scene.trajectory.start.position_world_m);
   pose_.orientation_world = to_quaternion(scene.trajectory.start.orientation_world);
   settled_volume_m3_ = sim_.world().soft().getVolume();
@@ -86,6 +67,8 @@ const HostStatus& SessionHost::step(DeviceStateExchange& state_in, ProxyExchange
   ToolState tool;
   if (epoch != 0) {
     tool = device_to_tool(mapping, as_eigen(device_.position_device_m), as_eigen(device_.velocity_device_m_per_s));
+    // The jaw closing rt_core computed for this sample, so both sides place the jaws alike.
+    tool.jaw_closing_m = device_.closing_axis_m;
   } else {
     // Before rt_core's first accepted sample: hold the tool where it is (the scene's start pose).
     tool.p_tool_world_m = pose_.position_world_m;

@@ -35,7 +35,7 @@ namespace {
 
 using WallClock = std::chrono::steady_clock;
 
-/// Status line refresh [s]: ~10×/s (issue 6), slow enough not to cost the host thread CPU.
+/// Status line refresh [s]: ~10×/s, slow enough not to cost the host thread CPU.
 constexpr double kStatusPeriod_s = 0.1;
 /// How often the main thread drains telemetry in real time [ms]: the 8192-sample ring holds
 /// 8 s at 1 kHz, so 10 ms is far inside it and keeps Ctrl-C responsive.
@@ -179,10 +179,9 @@ SessionOutcome run_session(const SessionOptions& options) {
   const double expected_s = until_interrupted ? 60.0 : duration_s + 1.0;
   // The view's picture model is built from the settled body (its rest shape is what the
   // deformation colours are measured from), here, before any thread steps the simulation, and
-  // its sinks (window, frame writer) start before the first tick. (Started after the rt
-  // thread's mlockall instead, Mesa mapping and locking LLVM cost the running rt loop a 30 ms
-  // gap and 71 overruns on this VM; started before, the cost is a longer rt set-up, measured in
-  // summary.json's rt_setup.seconds, and the session's length counts from the first tick.)
+  // its sinks (window, frame writer) start before the first tick: Mesa maps and locks LLVM when
+  // it starts, which stalls a running rt loop for tens of ms (docs/decisions.md); started here,
+  // that cost lands in the rt set-up (summary.json's rt_setup.seconds), not in the session.
   std::optional<viewer::RenderModel> view_model;
   if (options.view || !options.frames_dir.empty()) {
     try {

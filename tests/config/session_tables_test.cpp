@@ -3,6 +3,7 @@
 #include "fissure/config/session_tables.hpp"
 
 #include <filesystem>
+#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -37,8 +38,9 @@ buttons = 3
 )";
 
 TEST(SessionTables, ReadsTheMappingAndTheHandAndIgnoresTheHostsTables) {
-  const std::string text = std::string("[soft_body]\nshape = \"anything the host reads\"\n\n") + kTables;
-  const RtSessionConfig config = load_rt_session_config_text(text, "scenes/example.toml");
+  std::ostringstream text;
+  text << "[soft_body]\nshape = \"anything the host reads\"\n\n" << kTables;
+  const RtSessionConfig config = load_rt_session_config_text(text.str(), "scenes/example.toml");
   EXPECT_EQ(config.scene_name, "example");
   const DeviceMapping& m = config.device_mapping;
   EXPECT_DOUBLE_EQ(m.scale, 2.0);

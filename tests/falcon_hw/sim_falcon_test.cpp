@@ -332,18 +332,6 @@ TEST(SimFalcon, EndStopsHoldTheGripInsideTheReachableWorkspace) {
   }
 }
 
-TEST(SimFalcon, GravityIsOptional) {
-  SimFalconConfig config;
-  config.dynamics.gravity_device_m_per_s2 = {0.0, -kStandardGravity_m_per_s2, 0.0};
-  LockstepClock clock;
-  SimFalcon sim(config, clock);
-  DeviceReading reading;
-  clock.advance(100'000);  // 0.1 ms from rest: v ≈ g·t
-  ASSERT_EQ(sim.try_exchange(DeviceCommand{}, reading), IoStatus::kOk);
-  EXPECT_NEAR(sim.truth().velocity_device_m_per_s.y() / 1e-4, -kStandardGravity_m_per_s2, 0.01 * kStandardGravity_m_per_s2);
-  EXPECT_EQ(sim.truth().velocity_device_m_per_s.x(), 0.0);
-}
-
 TEST(SimFalcon, LongStallsAreSkippedNotIntegrated) {
   LockstepClock clock;
   SimFalcon sim(SimFalconConfig{}, clock);

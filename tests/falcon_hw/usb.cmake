@@ -1,4 +1,4 @@
-# falcon_hw USB part (issue 3): packet codec, stream parser (incl. the 10^6-stream fuzz),
+# falcon_hw USB part: packet codec, stream parser (incl. the 10^6-stream fuzz),
 # FTDI transport helpers, the fake device, and the whole driver run against the fake.
 fissure_add_test(falcon_hw_falcon_packet_test SOURCES falcon_packet_test.cpp LIBS fissure_falcon_hw)
 fissure_add_test(falcon_hw_falcon_stream_parser_test SOURCES falcon_stream_parser_test.cpp LIBS fissure_falcon_hw)

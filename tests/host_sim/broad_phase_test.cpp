@@ -328,7 +328,7 @@ TEST(BroadPhase, NodesMovedAfterBulletFittedTheirLeavesAreStillFound) {
       for (int a = 0; a < 3; ++a)
         outside_leaf_m = std::max({outside_leaf_m, static_cast<double>(lo[a] - n.m_x[a]), static_cast<double>(n.m_x[a] - hi[a])});
     }
-    constexpr double kFormerMarginM = 0.005;  // the old tree walk's allowance for that (the removed broad_phase_margin_m)
+    constexpr double kFormerMarginM = 0.005;  // a node-tree walk's fixed leaf margin (docs/decisions.md, "Broad phase")
     ASSERT_GT(outside_leaf_m, 2.0 * kFormerMarginM) << faces << " faces: the scenario must put nodes outside their leaves";
     // The plate arrives 1 mm into the sprung-back cap and stays there.
     ToolPose pose;

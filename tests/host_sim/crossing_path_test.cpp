@@ -60,7 +60,7 @@ TEST(CrossingPath, ThroughTheToolAndOutBeyondTheRimIsCrossed) {
   EXPECT_EQ(s.through_nodes, 1);
   EXPECT_EQ(s.crossed_nodes, 1);
   EXPECT_EQ(s.rim_passes, 0);
-  EXPECT_EQ(s.endpoint_crossed_nodes, 0);  // outside the footprint at the end: the old rule missed it
+  EXPECT_EQ(s.endpoint_crossed_nodes, 0);  // outside the footprint at the end: the end-point-only rule misses it
 }
 
 // A rim pass is decided per update: a path that crosses the mid-plane exactly on a side face

@@ -2,8 +2,7 @@
 // HELD soft node does while the tool holds still — the mechanism behind issue 5's "paired → hold
 // jitter ≤ 1 %".
 //  * The tool face is frictionless: a held node dragged along it slides freely, only its normal
-//    position is enforced (a Coulomb-friction option was measured and deleted:
-//    ThinBodyCollisionParams).
+//    position is enforced (Coulomb friction measures worse: ThinBodyCollisionParams).
 //  * A node lifted off the face moves freely and, pushed back, is held where it lands.
 #include "soft_scene_fixture.hpp"
 

@@ -1,4 +1,4 @@
-# Hold jitter of the paired collision (issue 5): a held soft node's friction / side memory
+# Hold jitter of the paired collision: a held soft node's friction / side memory
 # (host_sim/src/thin_body/enforced_displacement.cpp) and the bench's hold cells end to end.
 fissure_add_test(host_sim_enforced_displacement_test SOURCES enforced_displacement_test.cpp LIBS fissure_host_sim)
 # The bench's tunnelling-sweep hold cells, paired method, default parameters: crossing / penetration

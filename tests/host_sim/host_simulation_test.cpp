@@ -128,9 +128,9 @@ TEST(HostSimulation, OutOfContactTheCollisionReportsNothing) {
 
 
 // Bench collision item 2: the Hunt-Crossley force of a plate held 4 mm into a springy ball
-// (pose matching kMT = 0.05, no gravity) converges under mesh refinement in area-weighted mode.
-// Before the rim triangles were weighted by their contacted share (and with a pressure-less
-// shell whose cap fell away from the plate), 1280 / 5120 faces gave 1.47 / 1.25 N.
+// (pose matching kMT = 0.05, no gravity) converges under mesh refinement in area-weighted mode:
+// each rim triangle counts with its contacted share of its rest area (counted whole, the rim
+// triangles add an O(h) ring).
 double held_plate_force_n(int faces) {
   SceneDescription scene = load_scene(resolve_scene_path("spatula-sphere"));
   SoftSphere sphere = std::get<SoftSphere>(scene.soft_body.shape);
@@ -230,9 +230,9 @@ INSTANTIATE_TEST_SUITE_P(Speeds, FastPlunge, ::testing::Values(20.0, 50.0),
 // ---- Smooth contact force (normal_displacement measure, release ramp) -------------------------
 // The spatula scene's plate pressed into the ball at 0.05 m/s (the hand script's speed) to a
 // depth below the settled top, then held there while the pose dithers by ±40 µm steps every
-// 10 ms (the SimFalcon encoder step seen at the tool; deterministic LCG, seed fixed). The real-time
-// session showed the host force jumping between ≈1.5 N / 6 triangles and ≈4 N / 13 triangles at
-// such a hold, as single nodes were taken / released and each brought a whole triangle's x.
+// 10 ms (the SimFalcon encoder step seen at the tool; deterministic LCG, seed fixed). With the
+// centroid measure the host force jumps between ≈1.5 N / 6 triangles and ≈4 N / 13 triangles at
+// such a hold, as single nodes are taken / released and each brings a whole triangle's x.
 struct DitheredHold {
   std::vector<double> force_n;      // per step of the dithered hold
   std::vector<double> depth_m;      // plate bottom below the settled top
@@ -301,7 +301,7 @@ TEST_P(HeldDepth, DitheredHoldHasNoForceLevelJumps) {
   EXPECT_EQ(hold.crossed_max, 0);
   // ±40 µm at a few mm of depth changes k·xⁿ by n·Δx/x ≈ 1–2 %, plus the slope of the release
   // ramp of nodes hovering in front of the face (a few %); a node taken or released must not add
-  // a level of its own (the old measure jumped by 100–200 %): bound the per-step change and the
+  // a level of its own (the centroid measure jumps by 100–200 %): bound the per-step change and the
   // spread over the hold.
   EXPECT_LT(hold.max_step_change_n, 0.12 * hold.mean_n);
   EXPECT_LT(hold.std_n / hold.mean_n, 0.05);
@@ -313,10 +313,10 @@ INSTANTIATE_TEST_SUITE_P(Depths, HeldDepth, ::testing::Values(0.0035, 0.0045, 0.
                          });
 
 // First contact at the hand script's 0.05 m/s, pressing to 8 mm and pulling back out: once the
-// plate touches the ball, pressing deeper never empties the contact set (lockstep sessions showed
-// the set dropping to 0 for tens of ms while the plate went deeper, then coming back with a 5.5 N
-// spike), and the force follows the depth without jumps as nodes are taken and released (the
-// centroid measure stepped by 1–2 N at 50 µm when a node joined or left).
+// plate touches the ball, pressing deeper never empties the contact set (the failure this guards
+// against: the set dropping to 0 for tens of ms while the plate goes deeper, then coming back with
+// a 5.5 N spike), and the force follows the depth without jumps as nodes are taken and released
+// (the centroid measure steps by 1–2 N at 50 µm when a node joins or leaves).
 TEST(HostSimulation, PressAndReleaseAtHandSpeedKeepTheContactAndAContinuousForce) {
   const SceneDescription scene = load_scene(resolve_scene_path("spatula-sphere"));
   HostSimulation sim(scene);
@@ -396,7 +396,7 @@ TEST(HostSimulation, ClampOpeningReleasesTheBall) {
 }
 
 // The same release after other settling times. NOT MET (disabled so that it stays visible; run
-// with --gtest_also_run_disabled_tests). Session 9 measured the fully open jaw's force after
+// with --gtest_also_run_disabled_tests). Measured: the fully open jaw's force after
 // settling 0.1 / 0.2 / 0.25 / 0.3 / 0.35 / 0.4 / 0.5 s: 10.0 / 9.6 / 9.8 / 0 / 0 / 0 / 11.6 N.
 // Diagnosis (0.5 s): the squeezed ball bulges under jaw A's tip, and soft node 13 goes round the
 // tip onto the jaw's outer face, a legal pass round the rim. Its six triangles, whose other

@@ -2,11 +2,10 @@
 // internal interface: the contacts it finds must be exactly those of a brute-force sweep that
 // applies the node test to EVERY tool node against every candidate triangle — no bins, no
 // footprint, no skipping — in every step, including the steps that carry the soft surface through
-// the tool within one step. (Until the footprint was derived from the node test itself, it lost a
-// node that touched a triangle at the start of such a step and ended far behind it: its projection
-// on the end triangle lay outside the triangle's swept bounds + contact + memory depth. This test
-// found it in plate 7 / blade 4 / convex spatula 7 of 20 such steps, 1 to 21 tool nodes each, and
-// in 2 of 4 fine-plate steps, 712 and 2606 nodes.)
+// the tool within one step. (A footprint of the triangle's swept bounds + contact + memory depth
+// loses a node that touches a triangle at the start of such a step and ends far behind it: its
+// projection on the end triangle lies outside those bounds. This test catches that in about a
+// third of such steps.)
 // Random soft surfaces (a 1280-face sphere pressed into / swept past the tool, with every node
 // jittered), random side memory, box tools with rims, a convex spatula, and a fine plate whose
 // bins are clamped at 256 cells per axis (edge cells holding nodes from far outside them).
@@ -68,7 +67,7 @@ struct BruteForce {
   std::vector<int> face;
   std::vector<double> tau, facing;
   // The contact lies, across the bins' axes, outside its triangle's swept bounds + contact distance
-  // + memory depth (the footprint the sweep used to read, which lost such nodes).
+  // + memory depth (a footprint padded that way loses such nodes).
   std::vector<char> beyond_swept_bounds;
 };
 

@@ -94,7 +94,7 @@ TEST_P(PairedPlunge, NoCrossedNodesAndNoPenetrationAtAnySpeed) {
   const ToolNodes tool = make_tool(c.tool);
   PlungeSpec spec = spec_for(c.tool, c.speed_m_s);
   spec.check_triangles_cut = true;  // reported (a deep plunge wraps the sphere round the tool)
-  const PlungeOutcome out = test_scene::run_sphere_plunge(tool, CollisionMethod::kPaired, spec);
+  const PlungeOutcome out = test_scene::run_sphere_plunge(tool, SceneCollisionMethod::kPaired, spec);
   std::printf("[paired] %-17s %5.1f m/s: crossed %d, max penetration %.4f mm, max |F| %.3f N, excluded %d, "
               "contact steps %d, max triangles %d, triangles cut by the tool at end %d (max over run %d)\n",
               tool_name(c.tool).c_str(), c.speed_m_s, out.crossed_nodes, out.max_penetration_m * 1e3, out.max_force_n,
@@ -103,9 +103,8 @@ TEST_P(PairedPlunge, NoCrossedNodesAndNoPenetrationAtAnySpeed) {
   EXPECT_LE(out.max_penetration_m, 1e-4);
   EXPECT_TRUE(out.forces_finite);
   EXPECT_TRUE(out.positions_finite);
-  // (Changed with the edge nodes: edge-first, the blade used to cut between the sphere's nodes
-  // with no contact and no force, and this test asserted only that its face nodes met the
-  // triangles; its rim nodes now push the surface in like any other tool.)
+  // (Without the edge nodes an edge-first blade cuts between the sphere's nodes with no contact
+  // and no force; its rim nodes push the surface in like any other tool.)
   EXPECT_GT(out.steps_in_contact, 0) << "the tool must actually hit the sphere";
   EXPECT_GT(out.max_force_n, 0.0);
   EXPECT_EQ(out.max_both_face_contacts, 0) << "pairing leaves at most one face of a pair pushing";
@@ -153,7 +152,7 @@ TEST_P(EdgeFirstPlunge, TheRimPushesTheSurfaceInAtAnySpeed) {
   const PlungeCase c = GetParam();
   const ToolNodes tool = make_tool(c.tool);
   ASSERT_GT(tool.edge_node_count(), 0);
-  const PlungeOutcome out = test_scene::run_sphere_plunge(tool, CollisionMethod::kPaired, edge_first_spec(c.speed_m_s));
+  const PlungeOutcome out = test_scene::run_sphere_plunge(tool, SceneCollisionMethod::kPaired, edge_first_spec(c.speed_m_s));
   std::printf("[edge-first] %-15s %5.1f m/s: crossed %d, max penetration %.4f mm, F_y on arrival at 5 mm %.3f N, max F_y at "
               "5 mm %.3f N (end of hold %.3f N, max |F| over run %.3f N), rim %.2f mm into the soft top, triangles cut at end "
               "%d (max over run %d, deepest %.2e m), step time median %.1f us p99 %.1f us\n",
@@ -198,7 +197,7 @@ TEST(PairedCollision, WithoutEdgeNodesTheEdgeFirstBladeSlicesTheSphere) {
   shape.edge_nodes = false;
   const ToolNodes tool = ToolNodes::from_box(shape);
   ASSERT_EQ(tool.edge_node_count(), 0);
-  const PlungeOutcome out = test_scene::run_sphere_plunge(tool, CollisionMethod::kPaired, edge_first_spec(1.0));
+  const PlungeOutcome out = test_scene::run_sphere_plunge(tool, SceneCollisionMethod::kPaired, edge_first_spec(1.0));
   std::printf("[edge-first] no edge nodes 1.0 m/s: F_y at 5 mm %.3f N, triangles cut at end %d\n", out.force_y_at_arrival_n,
               out.triangles_cut_end);
   EXPECT_EQ(out.max_force_n, 0.0);
@@ -219,8 +218,8 @@ TEST(PairedCollision, EdgeNodesLeaveTheFaceFirstPlungeUnchanged) {
     for (const double speed : {0.1, 1.0, 10.0, 50.0}) {
       PlungeSpec spec = spec_for(Tool::kPlate4mm, speed);
       spec.check_triangles_cut = true;
-      const PlungeOutcome a = test_scene::run_sphere_plunge(faces_only, CollisionMethod::kPaired, spec);
-      const PlungeOutcome b = test_scene::run_sphere_plunge(with_edges, CollisionMethod::kPaired, spec);
+      const PlungeOutcome a = test_scene::run_sphere_plunge(faces_only, SceneCollisionMethod::kPaired, spec);
+      const PlungeOutcome b = test_scene::run_sphere_plunge(with_edges, SceneCollisionMethod::kPaired, spec);
       std::printf("[face-first] plate %.0f mm %5.1f m/s: triangles cut at end %d | %d (max over run %d | %d)\n", thickness * 1e3,
                   speed, a.triangles_cut_end, b.triangles_cut_end, a.max_triangles_cut, b.max_triangles_cut);
       std::printf("[face-first] plate %.0f mm %5.1f m/s: faces only | with edge nodes: crossed %d | %d, max pen %.4f | %.4f mm, "
@@ -303,7 +302,7 @@ TEST(PairedCollision, EdgeSweepingIntoATriangleInteriorPlacesItsVerticesOnTheRim
 // are both in contact and the trailing face must be excluded.
 TEST(PairedCollision, FastPlateExcludesTheTrailingFaceOfItsPairs) {
   const ToolNodes tool = test_scene::plate_tool(0.004);
-  const PlungeOutcome out = test_scene::run_sphere_plunge(tool, CollisionMethod::kPaired, spec_for(Tool::kPlate4mm, 50.0));
+  const PlungeOutcome out = test_scene::run_sphere_plunge(tool, SceneCollisionMethod::kPaired, spec_for(Tool::kPlate4mm, 50.0));
   EXPECT_GT(out.total_excluded, 0);
   EXPECT_EQ(out.total_both_face_contacts, 0);
   EXPECT_EQ(out.crossed_nodes, 0);
@@ -315,7 +314,7 @@ TEST(PairedCollision, OutOfContactTheStepDoesNothing) {
   world.step_dynamics();
   const ToolNodes tool = test_scene::plate_tool(0.004);
   auto collision = make_paired_collision(tool, world.soft(), ThinBodyCollisionParams{});
-  EXPECT_EQ(collision->method(), CollisionMethod::kPaired);
+  EXPECT_EQ(collision->method(), SceneCollisionMethod::kPaired);
   CollisionStepResult result;
   ToolPose previous;
   previous.position_world_m = Eigen::Vector3d(0, 0.3, 0);
@@ -442,8 +441,8 @@ TEST(PairedCollision, RandomPosesVelocitiesAndSpinsKeepTheInvariants) {
 
 TEST(PairedCollision, TwoRunsAreIdentical) {
   const ToolNodes tool = test_scene::plate_tool(0.004);
-  const PlungeOutcome a = test_scene::run_sphere_plunge(tool, CollisionMethod::kPaired, spec_for(Tool::kPlate4mm, 10.0));
-  const PlungeOutcome b = test_scene::run_sphere_plunge(tool, CollisionMethod::kPaired, spec_for(Tool::kPlate4mm, 10.0));
+  const PlungeOutcome a = test_scene::run_sphere_plunge(tool, SceneCollisionMethod::kPaired, spec_for(Tool::kPlate4mm, 10.0));
+  const PlungeOutcome b = test_scene::run_sphere_plunge(tool, SceneCollisionMethod::kPaired, spec_for(Tool::kPlate4mm, 10.0));
   EXPECT_EQ(a.final_nodes, b.final_nodes);
   EXPECT_EQ(a.final_force_y_n, b.final_force_y_n);
 }
@@ -457,7 +456,7 @@ TEST(PairedCollision, HoldGivesASteadyUpwardForce) {
     // its contact set still changes now and then (one triangle ≈ 0.4 N): reported, bounded looser.
     const double jitter_bound = speed < 5.0 ? 0.01 : 0.05;
     spec.hold_steps = 500;
-    const PlungeOutcome out = test_scene::run_sphere_plunge(tool, CollisionMethod::kPaired, spec);
+    const PlungeOutcome out = test_scene::run_sphere_plunge(tool, SceneCollisionMethod::kPaired, spec);
     // Last 0.3 s of the hold (the first 0.2 s let the sphere settle around the plate).
     const std::vector<double> hold(out.force_y_n.end() - 300, out.force_y_n.end());
     double mean = 0.0;
@@ -616,60 +615,12 @@ TEST(PairedCollision, RejectsAnotherSoftBodyAndBadParameters) {
 namespace fissure::host {
 namespace {
 
-// HuntCrossleyParams::rest_frame: a plate pressed quasi-statically 3 mm below the top of the
-// paper's sphere, once as built and once after the whole ball was lifted rigidly by 5 mm along
-// the plate's normal (the same shape, 5 mm higher). pose_matched carries the rest shape with
-// Bullet's pose-matching frame, so the same relative press gives the same force; world keeps the
-// rest positions where they were, so the lifted ball reads 5 mm less indentation.
-double force_after_rigid_lift(RestFrame rest_frame, double lift_m) {
-  test_scene::SoftWorld world(false);
-  world.add_sphere();
-  const ToolNodes tool = test_scene::plate_tool(0.002);
-  ThinBodyCollisionParams params;
-  params.hunt_crossley.rest_frame = rest_frame;
-  params.hunt_crossley.lambda = 0.0;  // elastic term only: the press is quasi-static
-  auto collision = make_paired_collision(tool, world.soft(), params);  // rest state: the ball as built
-  btSoftBody& soft = world.soft();
-  double top_m = -1.0;
-  for (int i = 0; i < soft.m_nodes.size(); ++i) {
-    soft.m_nodes[i].m_x += btVector3(0, static_cast<btScalar>(lift_m), 0);
-    top_m = std::max(top_m, static_cast<double>(soft.m_nodes[i].m_x.y()));
-  }
-  soft.updatePose();  // the pose-matching frame follows the lifted body (Bullet does this every step)
-  CollisionStepResult result;
-  ToolPose previous;
-  previous.position_world_m = Eigen::Vector3d(0.0, top_m + 0.0011, 0.0);  // bottom face 0.1 mm above the top
-  constexpr double kDepthM = 0.003;
-  constexpr int kSteps = 40;
-  for (int s = 1; s <= kSteps; ++s) {
-    ToolPose current = previous;
-    current.position_world_m.y() = top_m + 0.0011 - (0.0001 + kDepthM) * s / kSteps;
-    world.step_without_dynamics();
-    collision->step(previous, current, kStep_s, soft, result);
-    previous = current;
-  }
-  return result.force_on_tool_world_n.y();
-}
-
-TEST(PairedCollision, PoseMatchedRestFrameFollowsTheBodyAndTheWorldFrameDoesNot) {
-  const double pose_flat = force_after_rigid_lift(RestFrame::kPoseMatched, 0.0);
-  const double pose_lifted = force_after_rigid_lift(RestFrame::kPoseMatched, 0.005);
-  const double world_flat = force_after_rigid_lift(RestFrame::kWorld, 0.0);
-  const double world_lifted = force_after_rigid_lift(RestFrame::kWorld, 0.005);
-  std::printf("[paired] 3 mm press, ball lifted 0 / 5 mm: pose_matched %.4f / %.4f N, world %.4f / %.4f N\n", pose_flat, pose_lifted,
-              world_flat, world_lifted);
-  ASSERT_GT(pose_flat, 0.01) << "the plate must press the ball";
-  EXPECT_NEAR(pose_lifted / pose_flat, 1.0, 1e-3);
-  EXPECT_NEAR(world_flat / pose_flat, 1.0, 1e-3) << "at rest both frames agree";
-  EXPECT_LT(world_lifted, 0.5 * world_flat) << "world rest positions read the lift as 5 mm less indentation";
-}
-
 // Hunt-Crossley's ẋ in the paper's scenes, whose tools only translate (and the clamp's jaws slide along
 // the grip axis): each record's x is offset + n·(t − rest) along its triangle's plane, so its ẋ
 // can never be faster than the part moves, |Δp|/dt + |Δgap|/(2·dt). A triangle whose force plane
 // changes from one step to the next (its first colliding corner found now held on another plane,
-// round a rim) gave ẋ = Δx/dt across the switch before (hunt_crossley_force.cpp): in
-// clamp-sphere ~0.4 m/s of filtered ẋ on a jaw moving at cm/s.
+// round a rim) would give ẋ = Δx/dt across the switch if its filter were not restarted
+// (hunt_crossley_force.cpp): in clamp-sphere ~0.4 m/s of filtered ẋ on a jaw moving at cm/s.
 TEST(PairedCollision, NoRecordIndentsFasterThanItsPartMoves) {
   for (const char* name : {"spatula-sphere", "convex-spatula-sphere", "clamp-sphere", "clamp-vessel"}) {
     const SceneDescription scene = load_scene(resolve_scene_path(name));

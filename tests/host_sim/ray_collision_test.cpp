@@ -17,8 +17,8 @@ TEST(RayCollision, BothFacesPushAndNodesCrossWherePairedStaysClean) {
   for (const double speed : {0.1, 1.0, 10.0, 50.0}) {
     test_scene::PlungeSpec spec;
     spec.speed_m_s = speed;
-    const auto ray = test_scene::run_sphere_plunge(tool, CollisionMethod::kRay, spec);
-    const auto paired = test_scene::run_sphere_plunge(tool, CollisionMethod::kPaired, spec);
+    const auto ray = test_scene::run_sphere_plunge(tool, SceneCollisionMethod::kRay, spec);
+    const auto paired = test_scene::run_sphere_plunge(tool, SceneCollisionMethod::kPaired, spec);
     std::printf("[ray vs paired] %5.1f m/s: ray crossed %d, both-face contacts %d (max %d/step), max pen %.3f mm | "
                 "paired crossed %d, both-face %d\n",
                 speed, ray.crossed_nodes, ray.total_both_face_contacts, ray.max_both_face_contacts,
@@ -37,7 +37,7 @@ TEST(RayCollision, ReportsItsMethod) {
   test_scene::SoftWorld world(true);
   world.add_sphere();
   const ToolNodes tool = test_scene::plate_tool(0.004);
-  EXPECT_EQ(make_ray_collision(tool, world.soft(), ThinBodyCollisionParams{})->method(), CollisionMethod::kRay);
+  EXPECT_EQ(make_ray_collision(tool, world.soft(), ThinBodyCollisionParams{})->method(), SceneCollisionMethod::kRay);
 }
 
 }  // namespace

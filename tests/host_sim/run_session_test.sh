@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# One paper scene end to end in lockstep (issue 6): SimFalcon + rt_core + host_sim + proxy
+# One paper scene end to end in lockstep: SimFalcon + rt_core + host_sim + proxy
 # builder through `fissure run SCENE --lockstep`, then the session's summary.json is checked.
 #   run_session_test.sh FISSURE SCENE OUT_DIR safety   runs the session; asserts 0 crossed nodes,
 #                                                      no faults, |F| within the rt force limit,

@@ -134,7 +134,20 @@ TEST(SceneLoader, OutOfRangeValueNamesField) {
   const std::string bad = replace(good, "linear_stiffness_ratio = 1.0", "linear_stiffness_ratio = 2.0");
   expect_error(load_error(bad), line_of(bad, "linear_stiffness_ratio"), "soft_body.linear_stiffness_ratio", "must be in");
   const std::string bad_method = replace(good, "collision_method = \"paired\"", "collision_method = \"magic\"");
-  expect_error(load_error(bad_method), line_of(bad_method, "collision_method"), "simulation.collision_method", "not one of");
+  expect_error(load_error(bad_method), line_of(bad_method, "collision_method"), "simulation.collision_method",
+               "'magic' is not one of: paired, ray, bullet");
+}
+
+// The one name table for collision methods: scene files, `fissure sim --method` and
+// `fissure render --method` all read names through it.
+TEST(SceneLoader, CollisionMethodNamesParseBackAndNothingElseDoes) {
+  for (const SceneCollisionMethod method : kCollisionMethods) EXPECT_EQ(parse_collision_method(to_string(method)), method);
+  EXPECT_STREQ(to_string(SceneCollisionMethod::kPaired), "paired");
+  EXPECT_STREQ(to_string(SceneCollisionMethod::kRay), "ray");
+  EXPECT_STREQ(to_string(SceneCollisionMethod::kBullet), "bullet");
+  EXPECT_EQ(parse_collision_method("magic"), std::nullopt);
+  EXPECT_EQ(parse_collision_method(""), std::nullopt);
+  EXPECT_EQ(parse_collision_method("Paired"), std::nullopt);
 }
 
 TEST(SceneLoader, ShapeMatchingIsOptionalAndRangeChecked) {
@@ -188,9 +201,9 @@ TEST(SceneLoader, MalformedAnchorsNameFileLineAndField) {
 
 TEST(SceneLoader, DeformationMeasureIsOptionalAndChecked) {
   const std::string good = read(kScenes / "spatula-sphere.toml");
-  EXPECT_EQ(load_scene_text(good, "good.toml", kScenes).hunt_crossley.deformation_measure, DeformationMeasureKind::kNormalDisplacement);
+  EXPECT_EQ(load_scene_text(good, "good.toml", kScenes).hunt_crossley.measure, DeformationMeasure::kNormalDisplacement);
   const std::string paper = replace(good, "exponent_n = 1.5", "exponent_n = 1.5\ndeformation_measure = \"centroid_distance\"");
-  EXPECT_EQ(load_scene_text(paper, "good.toml", kScenes).hunt_crossley.deformation_measure, DeformationMeasureKind::kCentroidDistance);
+  EXPECT_EQ(load_scene_text(paper, "good.toml", kScenes).hunt_crossley.measure, DeformationMeasure::kCentroidDistance);
   const std::string bad = replace(good, "exponent_n = 1.5", "exponent_n = 1.5\ndeformation_measure = \"centroid\"");
   expect_error(load_error(bad), line_of(bad, "deformation_measure"), "hunt_crossley.deformation_measure", "not one of");
 }

@@ -1,4 +1,4 @@
-# `fissure run SCENE --lockstep` end to end for every paper scene (issue 6): the safety checks
+# `fissure run SCENE --lockstep` end to end for every paper scene: the safety checks
 # run the session (a fixture), the passivity check reads the summary it wrote.
 if(TARGET fissure)
   foreach(scene spatula-sphere convex-spatula-sphere clamp-sphere clamp-vessel)
@@ -11,8 +11,8 @@ if(TARGET fissure)
       COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/run_session_test.sh $<TARGET_FILE:fissure> ${scene} ${out} energy
       WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
     set_tests_properties(app.run_lockstep_passive.${scene} PROPERTIES LABELS "unit" FIXTURES_REQUIRED run_lockstep_${scene})
-    # clamp-sphere was a known failure (+3.4e-4 J) while x was the paper's centroid distance: a
-    # node wrapped round a jaw's rim was pushed by the reopening jaw with x ≈ 3 cm. With the
-    # normal-displacement measure (hunt_crossley_force.cpp) it is passive (-1.6e-7 J measured).
+    # clamp-sphere is passive with the normal-displacement measure (hunt_crossley_force.cpp,
+    # -1.6e-7 J), not with the paper's centroid distance as x (+3.4e-4 J: a node wrapped round a
+    # jaw's rim is pushed by the reopening jaw with x ≈ 3 cm).
   endforeach()
 endif()

@@ -30,7 +30,7 @@ namespace fissure::host::test_scene {
 
 inline constexpr double kSphereRadius_m = 0.05;  // paper / BRIEF §3: R = 5 cm
 inline constexpr int kSphereResolution = 63;     // CreateEllipsoid(.., 63) → 66 nodes, 128 faces (BRIEF §3)
-inline constexpr double kStep_s = 1e-3;          // 1 kHz host step (issue 5 tests)
+inline constexpr double kStep_s = 1e-3;          // 1 kHz host step
 
 class SoftWorld {
  public:
@@ -261,12 +261,12 @@ struct PlungeSpec {
 };
 
 // Drives the tool straight down (−y) through the sphere at constant speed, then holds.
-inline PlungeOutcome run_sphere_plunge(const ToolNodes& tool, CollisionMethod method, const PlungeSpec& spec,
+inline PlungeOutcome run_sphere_plunge(const ToolNodes& tool, SceneCollisionMethod method, const PlungeSpec& spec,
                                        const ThinBodyCollisionParams& params = ThinBodyCollisionParams{}) {
   SoftWorld world(true);
   world.add_sphere();
   for (int i = 0; i < spec.settle_steps; ++i) world.step_dynamics();
-  auto collision = method == CollisionMethod::kPaired ? make_paired_collision(tool, world.soft(), params)
+  auto collision = method == SceneCollisionMethod::kPaired ? make_paired_collision(tool, world.soft(), params)
                                                       : make_ray_collision(tool, world.soft(), params);
   CollisionStepResult result;
   result.reserve_for(world.soft().m_faces.size());

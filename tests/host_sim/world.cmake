@@ -1,5 +1,5 @@
 # Scenes, the Bullet world, the method-independent metrics, the `bullet` baseline and the
-# host step (issue 5, everything but the paired/ray algorithm). Suites mirror host_sim/src.
+# host step (everything but the paired/ray algorithm). Suites mirror host_sim/src.
 fissure_add_test(host_sim_scene_loader_test SOURCES scene_loader_test.cpp LIBS fissure_host_sim)
 fissure_add_test(host_sim_contact_metrics_test SOURCES contact_metrics_test.cpp LIBS fissure_host_sim)
 fissure_add_test(host_sim_soft_world_test SOURCES soft_world_test.cpp LIBS fissure_host_sim)

@@ -46,8 +46,8 @@ TEST(PassivityController, RampsTheReductionAlongTheForceInsteadOfSteppingIt) {
   state.force_sent_last_device_n = Eigen::Vector3d(3.0, 0, 0);  // acting now
   const Eigen::Vector3d v(0.1, 0.0, 0.0);                       // the wall pushes the hand out: returning energy
   const Eigen::Vector3d f(3.0, 0.0, 0.0);
-  // E' = 1e-4 + 6·0.1·1e-3 = 7e-4 J, 1.1 mJ above the reference −margin. The one-tick
-  // controller before session 2 removed the whole 3 N push in this one tick.
+  // E' = 1e-4 + 6·0.1·1e-3 = 7e-4 J, 1.1 mJ above the reference −margin. A one-tick
+  // controller (plain Hannaford–Ryu) would remove the whole 3 N push in this one tick.
   const double predicted_j = 7e-4;
   // The share of F that withholds that within dissipation_time_s: 1.1e-3/(0.05·0.1·3) = 7.3 %
   // (E' is below the ramp's energy budget, 10 margins: no full cut).
@@ -59,7 +59,7 @@ TEST(PassivityController, RampsTheReductionAlongTheForceInsteadOfSteppingIt) {
   const double energy_bounded_step_n =
       0.1 * 3.0 * kPeriod_s * 3.0 / (2.0 * kPassivityRampEnergyBudgetMargins * config.margin_j);
   const double first_step_n = std::max(config.max_correction_step_n * urgency, energy_bounded_step_n);
-  EXPECT_LT(first_step_n, 0.15);  // still a ramp: the old controller removed all 3 N at once
+  EXPECT_LT(first_step_n, 0.15);  // still a ramp: a one-tick controller removes all 3 N at once
   const double damping_step = config.max_damping_n_s_per_m * kPeriod_s / config.damping_ramp_s;
   const Eigen::Vector3d out = passivity_control(config, state, f, v, v, kPeriod_s);
   EXPECT_NEAR(state.reduction_n, first_step_n, 1e-12);
@@ -207,9 +207,9 @@ TEST(PassivityController, KeepsTheBaseRampAtAHold) {
 // Work done while safety ramps the force back in after a device fault is energy the device put
 // into the hand like any other. Up to kPassivityRecoveryForgiveness_j per fault (bringing a
 // force back at a static hold) the reduction g ignores it and only the damper β acts (the
-// wall is not held soft while the hand holds still); beyond that g acts as well. Until
-// session 3 g ignored all of it and nothing took it back: the stress harness's encoder_jumps
-// case gained ≈ 5 mJ per injected fault, 4.7 J over 10⁶ ticks.
+// wall is not held soft while the hand holds still); beyond that g acts as well. With g
+// ignoring all of it nothing takes it back: the stress harness's encoder_jumps case gains
+// ≈ 5 mJ per injected fault, 4.7 J over 10⁶ ticks.
 TEST(PassivityController, ForgivesABoundedShareOfTheRecoveryWorkForTheReductionOnly) {
   PassivityConfig config;
   const Eigen::Vector3d f(2.0, 0.0, 0.0);
@@ -289,8 +289,8 @@ TEST(PassivityController, RestartDropsTheCorrection) {
 
 // The controller works on the force the device renders (clamped to max_force_n), not on an
 // environment force safety will clamp afterwards: against a 27 N contact (rendered at 8 N) its
-// first reduction already lowers what goes out. Before session 4 g acted on the 27 N, and the
-// first 70 % of the reduction left 8 N going out (hc_lambda_over_k_1 stress case).
+// first reduction already lowers what goes out. Acting on the 27 N, the first 70 % of the
+// reduction would leave 8 N going out (hc_lambda_over_k_1 stress case).
 TEST(PassivityController, ReducesTheForceTheDeviceRendersNotTheUnclampedOne) {
   PassivityConfig config;
   PassivityState state;
@@ -471,8 +471,8 @@ LoopResult run_wall(const PassivityConfig& config, double stiffness_n_per_m, Pla
 
 // A stationary-ish hold: the hand presses 1 mm into a 3000 N/m wall (≈ 3 N) and trembles by
 // ±30 µm at 8 Hz, so the encoder toggles between neighbouring counts; the host force varies
-// by ±30 % at 7 Hz on its own — the situation of spatula-sphere's hold (BRIEF issue: the old
-// controller cut 2–4 N in one tick at every outward count, 2.3 N steps at 1 kHz).
+// by ±30 % at 7 Hz on its own — the situation of spatula-sphere's hold, where a one-tick
+// controller cuts 2–4 N in one tick at every outward count (2.3 N steps at 1 kHz).
 TEST(PassivityClosedLoop, QuantisedHoldAgainstAStiffProxyHasNoForceSteps) {
   PassivityConfig config;
   Plant plant;
@@ -633,16 +633,16 @@ TEST(PassivityClosedLoop, AFlickOutOfAStiffDampedContactStaysWithinTheEnergyBoun
   const double worst_j = worst_flick_energy_j(PassivityConfig{}, &before_flick);
   EXPECT_LE(worst_j, 0.8 * kStressEnergyBound_j);  // 16.1 mJ measured
   // Until the flick (press, hold, slow follow) the hand is never fast: no step from the bound,
-  // and no force step beyond the wall's own (K·count = 0.25 N per count of motion). (The
-  // controller before session 4 stepped 4 N there: its reduction of the unclamped 30 N only
-  // reached the hand once it exceeded 22 N, then all at once.)
+  // and no force step beyond the wall's own (K·count = 0.25 N per count of motion). (A
+  // controller reducing the unclamped 30 N steps 4 N there: its reduction only reaches the
+  // hand once it exceeds 22 N, then all at once.)
   EXPECT_EQ(before_flick.bound_ticks_before_flick, 0u);
   EXPECT_LE(before_flick.max_step_before_flick_n, 0.35);
 }
 
-// What the test above holds down is real: the controller before session 4 (reduction of the
-// unclamped force, no energy bound) let the same flicks reach 30.5 mJ, and acting on the
-// rendered force alone is not enough (29.2 mJ): the ramps act a tick too late.
+// What the test above holds down is real: a controller reducing the unclamped force with no
+// energy bound lets the same flicks reach 30.5 mJ, and acting on the rendered force alone is
+// not enough (29.2 mJ): the ramps act a tick too late.
 TEST(PassivityClosedLoop, TheFlickExceedsTheEnergyBoundWithoutEnergyBounding) {
   PassivityConfig before_session_4;
   before_session_4.energy_bounding = false;

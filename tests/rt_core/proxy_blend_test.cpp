@@ -48,8 +48,8 @@ TEST(ProxyBlend, NoSwapMeansNoOffset) {
 }
 
 // A swap while the tool moves: the motion under the proxy in use changes the force by m per
-// tick, and the walk may only take what m leaves of the bound. Before session 4 the walk always
-// took the full bound on top of m (0.05 + 0.03 = 0.08 N here).
+// tick, and the walk may only take what m leaves of the bound. A walk taking the full bound on
+// top of m would step by 0.05 + 0.03 = 0.08 N here.
 TEST(ProxyBlend, TheWalkSharesTheBoundWithTheToolsMotion) {
   const double max_step_n = 0.05;
   const Eigen::Vector3d motion_per_tick_n(0.0, 0.03, 0.0);  // pressing in: the force grows

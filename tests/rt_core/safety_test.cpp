@@ -96,7 +96,7 @@ TEST(Safety, SoftWallPushesBackBeyondTheWorkspaceRadius) {
   EXPECT_EQ(flags & kFlagSoftWall, 0u);
   input.force_device_n.setZero();
   input.p_device_m = config.workspace_centre_device_m + Eigen::Vector3d(0.0, 0.0, config.workspace_radius_m + 0.01);
-  EXPECT_EQ(settle(config, state, input, flags), Eigen::Vector3d::Zero());  // no wall added here any more
+  EXPECT_EQ(settle(config, state, input, flags), Eigen::Vector3d::Zero());  // the wall is the tick's, added before the controller
   EXPECT_EQ(flags & kFlagSoftWall, 0u);
 }
 

@@ -117,8 +117,8 @@ TEST(Tick, ProxySwapChangesTheForceByAtMostTheBlendBoundPerTick) {
 // Issue 6's bound is on the rendered contact force, and the tool moves while a swap blends:
 // the swap's walk shares the bound with the motion's own step (proxy_blend.hpp). Here the
 // tool presses into the plane 20 µm per tick (≈ 0.025 N per encoder count at 500 N/m) while a
-// 2 N swap offset walks out; before session 4 every tick with a count change stepped by
-// 0.05 N + the motion.
+// 2 N swap offset walks out; a walk on top of the motion would step by 0.05 N + the motion on
+// every tick with a count change.
 TEST(Tick, ProxySwapWhileTheToolMovesKeepsTheRenderedStepWithinTheBound) {
   Harness h;
   h.settle();
@@ -248,8 +248,8 @@ TEST(Tick, DeviceTimeoutGivesZeroForceAndRecoversAfterCleanTicks) {
 }
 
 // A swap while a device fault is latched leaves no offset behind: the force is zero and comes
-// back through safety's ramp-in. Before session 3 the old proxy, evaluated where the hand was
-// after the fault, left its force as a blend offset rendered after recovery with no contact
+// back through safety's ramp-in. Otherwise the old proxy, evaluated where the hand is after
+// the fault, leaves its force as a blend offset rendered after recovery with no contact
 // (encoder_jumps stress case: 25 N walked down over 0.5 s).
 TEST(Tick, ProxySwapDuringADeviceFaultLeavesNoOffsetAfterRecovery) {
   Harness h;

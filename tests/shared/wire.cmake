@@ -1,4 +1,4 @@
-# Wire codec and transports (issue 6, "Transports"). One suite per source it mirrors; the
+# Wire codec and transports. One suite per source it mirrors; the
 # fault-injection suite drives the codec, reassembly and link over a damaged loopback.
 fissure_add_test(shared_crc32c_test SOURCES crc32c_test.cpp LIBS fissure_shared)
 fissure_add_test(shared_wire_codec_test SOURCES wire_codec_test.cpp LIBS fissure_shared)

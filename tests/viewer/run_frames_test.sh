@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# `fissure run SCENE --lockstep --frames DIR --frame-every K` (issue 8), no GPU, no display:
+# `fissure run SCENE --lockstep --frames DIR --frame-every K`, no GPU, no display:
 #   * the session writes one PNG per K host steps (ceil(host_steps / K), none dropped: lockstep
 #     waits for each), listed in DIR/frames.json;
 #   * every frame is a picture (not blank) with the sphere's silhouette where the camera puts it

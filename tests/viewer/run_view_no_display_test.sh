@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# `fissure run SCENE --lockstep --view` with no display (issue 8): exactly one line says so, the
+# `fissure run SCENE --lockstep --view` with no display: exactly one line says so, the
 # session runs on to the end (exit 0, summary written, the window recorded as requested but not
 # open).
 #   run_view_no_display_test.sh FISSURE SCENE OUT_DIR

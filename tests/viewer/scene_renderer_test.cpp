@@ -1,4 +1,4 @@
-// Headless image tests (issue 8): render known scenes with EGL + Mesa llvmpipe (no GPU, no
+// Headless image tests: render known scenes with EGL + Mesa llvmpipe (no GPU, no
 // display), write the PNG, read it back, and check the picture: not blank, the sphere's
 // silhouette where the camera puts it, the tool on the right side of the surface after a fast
 // plunge with the paired method (and, as the check's own control, inside the sphere with

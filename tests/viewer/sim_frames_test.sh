@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# `fissure sim SCENE --frames DIR --frame-every K` (issue 8), no GPU, no display: one PNG per K
+# `fissure sim SCENE --frames DIR --frame-every K`, no GPU, no display: one PNG per K
 # steps (ceil(steps / K), each waited for), listed in DIR/frames.json, each a real picture (not
 # the background colour alone), and the summary JSON reports them.
 #   sim_frames_test.sh FISSURE SCENE OUT_DIR FRAME_EVERY SECONDS

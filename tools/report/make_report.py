@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Turn the JSON of `fissure bench all` into PNG plots and a Markdown report (issue 7).
+"""Turn the JSON of `fissure bench all` into PNG plots and a Markdown report.
 
 usage: make_report.py DIR [--md FILE] [--images DIR]
 
@@ -31,7 +31,7 @@ from targets import MET, MISSED, NOT_CHECKED, Target, evaluate_all  # noqa: E402
 REGENERATE = "build/bin/fissure bench all --out out/bench --docs docs --stress-full"
 
 BENCHMARKS = ["kinematics", "rt", "collision", "proxy", "pareto", "view", "stress", "stress_full"]
-# `fissure render` children of bench all: one PNG frame each of the 10 m/s plunge (issue 8).
+# `fissure render` children of bench all: one PNG frame each of the 10 m/s plunge.
 PLUNGE_FRAMES = {"plunge_bullet": "plunge-bullet", "plunge_paired": "plunge-paired"}
 
 

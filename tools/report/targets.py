@@ -239,8 +239,8 @@ def collision_targets(col):
         small, large = paired_contact[0], paired_contact[-1]
         growth = large["collision_median_us"] / small["collision_median_us"]
         # Judged on the spread over every mesh, not only the two ends: the 128-face ball needs a
-        # deep press for the same triangle count, which puts ~40× the tool area in contact
-        # (session 3 measurement), so its row is dear and an end-to-end ratio hides growth
+        # deep press for the same triangle count, which puts ~40× the tool area in contact,
+        # so its row is dear and an end-to-end ratio hides growth
         # with the mesh between the finer meshes.
         cheapest = min(paired_contact, key=lambda r: r["collision_median_us"])
         dearest = max(paired_contact, key=lambda r: r["collision_median_us"])
@@ -345,7 +345,7 @@ def stress_full_targets(stress):
     if short:
         measured += "; fewer than 1e6 ticks: " + ", ".join(short)
     # How much of the run exercised contact at all: a body knocked away early leaves a case
-    # with 10^6 ticks of free motion (session 3: median 0.4 %), which passes without testing
+    # with 10^6 ticks of free motion, which passes without testing
     # the contact it is about.
     fractions = sorted(c["contact_fraction"] for c in cases if c.get("ticks", 0) > 0 and "contact_fraction" in c)
     if fractions:

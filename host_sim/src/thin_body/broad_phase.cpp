@@ -38,27 +38,24 @@
 //      Bullet gives none. The scan reads each node's two positions once, in memory order (one cache
 //      line per node, software-prefetched), against one union box; only nodes in it get the exact
 //      tests. Its price (bench collision, 10 242 nodes, after Bullet's step has evicted the cache):
-//      ~60 µs a step in or out of contact, vs ~2 µs for the old out-of-contact root test; in
-//      contact it is cheaper than the tree walk it replaces (~2000 cold tree nodes for a fixed
-//      contact on the 20 480-face sphere).
-//      (A separate bounds pass after Bullet's solve was measured on 2026-11-22 at +38-48 µs a
-//      step on 10 242 nodes — the nodes are cold again by then; fused into the solve's own last
-//      node loop, as NodeBoundsSolver does, it costs ~5 instructions a node: 0. above.)
+//      ~60 µs a step in or out of contact; in contact that is less than a walk of Bullet's node
+//      tree costs (~2000 cold tree nodes for a fixed contact on the 20 480-face sphere).
+//      (A separate bounds pass after Bullet's solve costs +38-48 µs a step on 10 242 nodes — the
+//      nodes are cold again by then; fused into the solve's own last node loop, as
+//      NodeBoundsSolver does, it costs ~5 instructions a node: 0. above.)
 //   2. The faces around last step's candidate nodes are re-tested directly: a node held on the tool
 //      last step keeps its faces for the release band even where the seed query does not reach.
 //   3. Most faces reached through the seeds lie in the seed band only and are rejected (bench
-//      collision's 20 480-face same_contact hold: 247 seeds reached 552 faces for 24 candidates
-//      before the seed boxes were cut back on the body's side, 45 seeds reach 116 now).
+//      collision's 20 480-face same_contact hold: 45 seeds reach 116 faces for 24 candidates).
 //      Each reached face is first tested from its vertices' WORLD bounds (m_q box, m_x box, in
 //      Bullet's float with SIMD), carried into the tool frame whole (Arvo's box transform, see
 //      ToolFrameBounds): every tool-frame start/end position of a vertex lies in those carried
 //      boxes, so a face they keep away from every query is one the exact test would reject — the
 //      candidate set is unchanged (tests/host_sim/broad_phase_test.cpp: brute force, every reached
 //      face decided as the exact test decides, and rotated / stretched / held / memory cases at
-//      the pre-filter's edge). Only the faces it keeps (24 of the 552 there) get their vertices
-//      transformed into the tool frame and stamped. Measured on that hold (a driver stepping it,
-//      3 interleaved runs, load 6-12): broad stage 135-145 µs before, 130-135 after; the band is
-//      memory latency (a few lines per face and vertex, cold after Bullet's step), not arithmetic.
+//      the pre-filter's edge). Only the faces it keeps get their vertices transformed into the
+//      tool frame and stamped. That saves only a few µs: the band's cost is memory latency (a few
+//      lines per face and vertex, cold after Bullet's step), not arithmetic.
 // Out of contact: the whole-body test fails (or, without bounds, the scan finds no seed); nothing
 // else runs.
 #include "collision_state.hpp"

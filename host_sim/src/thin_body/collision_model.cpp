@@ -55,19 +55,6 @@ void take_rest_state(const btSoftBody& soft, SoftSurfaceModel& model) {
     model.rest_node_world_m[static_cast<std::size_t>(i)] = to_eigen(soft.m_nodes[i].m_x);
     model.rest_bounds_world_m.extend(model.rest_node_world_m[static_cast<std::size_t>(i)]);
   }
-  // With pose matching, the rest positions are also kept in the shape-matching frame (com from the
-  // settled positions with Bullet's own weights, rotation from its last fit), for
-  // HuntCrossleyParams::rest_frame = pose_matched (hunt_crossley_force.cpp).
-  model.rest_in_pose_frame = soft.m_pose.m_bframe && soft.m_pose.m_wgh.size() == model.node_count;
-  model.rest_node_pose_m.assign(static_cast<std::size_t>(model.node_count), Eigen::Vector3d::Zero());
-  if (model.rest_in_pose_frame) {
-    const Eigen::Vector3d com = to_eigen(soft.evaluateCom());
-    Eigen::Matrix3d rotation;
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) rotation(r, c) = soft.m_pose.m_rot[r][c];
-    for (int i = 0; i < model.node_count; ++i)
-      model.rest_node_pose_m[static_cast<std::size_t>(i)] = rotation.transpose() * (model.rest_node_world_m[static_cast<std::size_t>(i)] - com);
-  }
   model.rest_centroid_world_m.resize(static_cast<std::size_t>(model.face_count));
   model.rest_area_m2.resize(static_cast<std::size_t>(model.face_count));
   double volume6 = 0.0;

@@ -25,12 +25,6 @@ struct SoftSurfaceModel {
   std::vector<int> faces_of_node_begin;  // CSR: faces around each node
   std::vector<int> faces_of_node;
   std::vector<Eigen::Vector3d> rest_node_world_m;      // rest positions (world, when the rest state was taken)
-  // normal_displacement's rest positions carried with the soft body: when Bullet pose matching is
-  // on (btSoftBody::m_pose.m_bframe), each node's rest position in the pose frame (com + rotation
-  // of the shape-matching fit), so that the rest place NOW is m_pose.m_com + m_pose.m_rot · this;
-  // without a pose frame the world rest positions are used (rest_in_pose_frame = false).
-  bool rest_in_pose_frame = false;
-  std::vector<Eigen::Vector3d> rest_node_pose_m;
   std::vector<Eigen::Vector3d> rest_centroid_world_m;  // centroid_distance's rest centroids
   std::vector<double> rest_area_m2;
   double outward_sign = 1.0;   // multiplies Bullet's winding normal to point out of the soft body

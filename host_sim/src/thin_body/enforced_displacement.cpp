@@ -55,8 +55,8 @@ struct Writer {
   bool fixed(int node) const { return soft.m_nodes[node].m_im == 0; }
 
   // Where a node goes on `plane` (+ skin): straight along the plane's normal (the tool face is
-  // frictionless: a held node slides freely along it; a Coulomb-friction option was measured and
-  // deleted, see ThinBodyCollisionParams).
+  // frictionless: a held node slides freely along it; friction measures worse, see
+  // ThinBodyCollisionParams).
   Eigen::Vector3d target_on_plane(int node, int plane_index) const {
     const ToolPlane& plane = model.tool.planes()[static_cast<std::size_t>(plane_index)];
     const double target = plane.offset_m + model.params.skin_m;

@@ -82,19 +82,6 @@ void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, co
   const double alpha = frame.dt_s / (frame.dt_s + time_constant_s);
   const auto& planes = model.tool.planes();
   const bool normal_measure = hc.measure == DeformationMeasure::kNormalDisplacement;
-  // HuntCrossleyParams::rest_frame = pose_matched: the rest shape is carried with Bullet's
-  // pose-matching frame (com + rotation of the shape-matching fit, updated in this step's
-  // btSoftBody::predictMotion), so x measures how far the tool pushed a node from the place the
-  // body's own shape matching pulls it back to (Müller et al. 2005's goal positions), not from
-  // where it rested in the world when the rest state was taken. Not the default: see there.
-  const bool pose_frame = hc.rest_frame == RestFrame::kPoseMatched && model.soft.rest_in_pose_frame;
-  Eigen::Matrix3d pose_rotation = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d pose_com = Eigen::Vector3d::Zero();
-  if (pose_frame) {
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) pose_rotation(r, c) = soft.m_pose.m_rot[r][c];
-    pose_com = to_eigen(soft.m_pose.m_com);
-  }
   for (const int face : data.contacted_faces) {
     const auto f = static_cast<std::size_t>(face);
     const Eigen::Vector3d c_now = centroid(model.soft, soft, face, false);
@@ -117,8 +104,7 @@ void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, co
         const auto v = static_cast<std::size_t>(node);
         if (data.moved_stamp[v] != frame.step) continue;  // not a colliding vertex
         const double share = data.node_share[v];
-        const Eigen::Vector3d rest =
-            pose_frame ? Eigen::Vector3d(pose_com + pose_rotation * model.soft.rest_node_pose_m[v]) : model.soft.rest_node_world_m[v];
+        const Eigen::Vector3d& rest = model.soft.rest_node_world_m[v];
         const double x = std::max(0.0, plane.offset_m + normal_world.dot(frame.t_cur - rest));
         const double x_start = std::max(0.0, plane.offset_m + normal_prev_world.dot(frame.t_prev - rest));
         const std::size_t slot = 3 * f + corner;
@@ -128,7 +114,7 @@ void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, co
         // rim): then last step's x was taken along another normal, and differencing across the
         // switch turned a change of plane into an indentation rate (mm per ms is m/s, × λ). The
         // filter restarts from x_start at a switch, as at first contact.
-        if (!pose_frame && data.hc_corner_stamp[slot] == frame.step - 1 &&
+        if (data.hc_corner_stamp[slot] == frame.step - 1 &&
             std::abs(data.hc_corner_x_prev_m[slot] - x_start) > kPlaneSwitchTolerance_m)
           data.hc_corner_stamp[slot] = -1;
         const double rate = filtered_rate(data.hc_corner_stamp[slot], data.hc_corner_x_prev_m[slot],

@@ -17,13 +17,13 @@
 //
 // The footprint: a triangle visits only the tool nodes binned under a box that holds every node
 // the test above can accept for it, derived from the test itself (footprint_for_crossing,
-// footprint_for_touching), not the triangle's swept bounds padded by the contact distance and the
-// memory depth that it used to be: a node touching A at the start may end far behind B when a step
-// carries the soft surface through the tool, and project on B from far outside B's bounds along a
-// tilted normal — such nodes were lost (1 to 21 tool nodes in about a third of such random steps,
-// 712 and 2606 on a 0.2 mm grid; no soft node crossed, but a triangle interior could be pierced by
-// a tool node). For a triangle that only translates relative to the tool the box is tighter than
-// the old one (its swept bounds + d_c, and B's bounds pushed along n_B by how far a node can start
+// footprint_for_touching), not from the triangle's swept bounds padded by the contact distance and
+// the memory depth: a node touching A at the start may end far behind B when a step carries the
+// soft surface through the tool, and project on B from far outside B's bounds along a tilted
+// normal — such a padded box loses it (1 to 21 tool nodes in about a third of such random steps;
+// no soft node crosses, but a tool node can pierce a triangle interior). For a triangle that only
+// translates relative to the tool the box is tighter than the padded one (its swept bounds + d_c,
+// and B's bounds pushed along n_B by how far a node can start
 // behind A); turning and deforming triangles get a margin that grows with how far their normal
 // can turn within the step.
 //
@@ -37,9 +37,9 @@
 // cells is cut to the interval where the triangle's end plane can come within contact_distance of
 // a node (the same bound per cell, linear along the row). None of this changes a contact (tests/
 // host_sim/node_sweep_test.cpp compares with the node test applied to every tool node).
-// Measured (bench collision's scaling scene, 128 faces, plate 100 × 2 × 100 mm on a 2 mm grid, held
-// 4 mm deep, 12 contacted triangles): 4618 node tests a step before, 810 after; the stage
-// 18.0 → 7.8 µs.
+// On a plate held in a coarse ball most of its nodes lie under a skipped plane or outside a row's
+// interval, so the stage runs several times fewer node tests than a plain footprint visit
+// (figures in docs/decisions.md, "Node sweep").
 #include "collision_state.hpp"
 
 #include <algorithm>
@@ -222,7 +222,7 @@ Eigen::AlignedBox3d footprint_for_crossing(const Triangle& start, const Triangle
 // −start_depth, so when n_A·n_B > 0, s ≥ (−start_depth − max over B's corners of n_A·(q − a_A)) /
 // n_A·n_B (exact: linear in q). When a step carries the soft surface through the tool that is the
 // distance carried, and p can end far behind B, far outside B's own bounds along a tilted normal —
-// the node the old footprint (the swept bounds + d_c + memory depth) lost. Otherwise (a normal
+// the node a footprint of the swept bounds + d_c + memory depth loses. Otherwise (a normal
 // turned by more than 90°) s_start − s comes from its extreme over the tool's bounds. Per axis,
 // p_k ∈ the tool's bounds and q_k ∈ B's bounds also bound s (through the thin axis mostly).
 Eigen::AlignedBox3d footprint_for_touching(const Triangle& start, const Triangle& end, const Eigen::AlignedBox3d& tool_bounds, double contact,
@@ -382,7 +382,7 @@ void sweep_tool_nodes(const CollisionModel& model, CollisionData& data) {
     // edge cells, which also hold the nodes clamped into them, are unbounded outwards). A skipped
     // cell only holds nodes with s_end > contact + kPlaneSkipSlack_m, which the node test drops:
     // the contacts are the same, only fewer nodes are read — a triangle tilted against the tool
-    // no longer reads the nodes under the part of its box that its plane passes far above.
+    // does not read the nodes under the part of its box that its plane passes far above.
     const double n_u = end.normal[bins.axis_u];
     const double n_v = end.normal[bins.axis_v];
     const double n_w = end.normal[axis_w];

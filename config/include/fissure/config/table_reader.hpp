@@ -6,11 +6,13 @@
 // session configuration (fissure-rt) read their tables through it.
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <map>
 #include <optional>
 #include <set>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -20,6 +22,12 @@
 #include "fissure/shared/messages.hpp"
 
 namespace fissure::config {
+
+/// The text of a configuration file; SceneError (line 0) when it cannot be read.
+[[nodiscard]] std::string read_config_file(const std::filesystem::path& file);
+
+/// TOML text → its root table; a syntax error is a SceneError naming the line.
+[[nodiscard]] toml::table parse_toml(std::string_view text, const std::string& file_label);
 
 /// 1-based line of a node in its file.
 [[nodiscard]] int line_of(const toml::node& node);

@@ -1,5 +1,5 @@
 #pragma once
-// The scripted operator's hand on SimFalcon's grip (issue 3). A HandScript (shared/
+// The scripted operator's hand on SimFalcon's grip. A HandScript (shared/
 // session_config.hpp, filled in from the scene/session file) is a list of straight-line legs
 // "go to this point at this speed, then hold for this long", plus a button script. The player
 // turns it into a function of session time:

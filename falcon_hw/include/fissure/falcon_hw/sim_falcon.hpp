@@ -1,5 +1,5 @@
 #pragma once
-// SimFalcon: the Novint Falcon twin that CI and the lockstep sessions run against (issue 3).
+// SimFalcon: the Novint Falcon twin that CI and the lockstep sessions run against.
 // It implements HapticDevice with the Falcon's raw wire values, so rt_core cannot tell it
 // from the USB driver except by name() == "sim-falcon" (PX4's rule: only the leaf driver
 // changes between hardware and simulation).
@@ -15,7 +15,7 @@
 //
 // End-effector model (device frame, isotropic — the real Falcon's apparent mass varies over
 // the workspace; one scalar is enough to test the control loop against):
-//   m·dv/dt = F_motor + F_hand + F_end_stop + m·g − b·v,   dp/dt = v
+//   m·dv/dt = F_motor + F_hand + F_end_stop − b·v,   dp/dt = v
 // F_motor = (∂p/∂θ)⁻ᵀ·τ from the commanded motor counts (τ = Jᵀ·F inverted, J = ∂p/∂θ from
 // kinematics.hpp), τ from motor_counts_to_torque with each command clamped to ±kMaxMotorCount
 // and each torque to max_motor_torque_nm. The damping term is integrated exactly
@@ -61,16 +61,11 @@ inline constexpr double kSimPhysicsRate_hz = 20'000.0;
 /// stop. ω·h ≈ 0.06 at 20 kHz: well inside the integrator's stable range.
 inline constexpr double kSimEndStopStiffness_n_per_m = 100'000.0;
 inline constexpr double kSimEndStopDamping_n_s_per_m = 100.0;
-/// Standard gravity, for SimDynamicsConfig::gravity_device_m_per_s2 (device y is up).
-inline constexpr double kStandardGravity_m_per_s2 = 9.80665;
 
 /// The mechanical model. Defaults above; every field may be changed per session.
 struct SimDynamicsConfig {
   double effective_mass_kg = kSimEffectiveMass_kg;
   double viscous_damping_n_s_per_m = kSimViscousDamping_n_s_per_m;
-  /// Off by default: whether the grip sags under gravity depends on the unit and is not
-  /// identified here; set {0, −kStandardGravity_m_per_s2, 0} to test gravity compensation.
-  Vec3 gravity_device_m_per_s2{0.0, 0.0, 0.0};
   double physics_rate_hz = kSimPhysicsRate_hz;
   /// Longest gap one exchange integrates; beyond it (a stalled real-time thread on the
   /// MonotonicClock) the excess time is skipped with the state frozen, and counted, so one

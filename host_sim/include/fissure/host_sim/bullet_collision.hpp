@@ -75,7 +75,7 @@ class BulletCollision final : public ThinBodyCollision {
   /// Nothing to forget and nothing to put out here: Bullet finds its soft-rigid contacts afresh
   /// each step (SDF_RS), and its contact pushes out nodes inside the part along the SDF gradient.
   int reseat(const ToolPose& /*previous*/, const ToolPose& /*current*/, btSoftBody& /*soft*/) override { return 0; }
-  [[nodiscard]] CollisionMethod method() const override { return CollisionMethod::kBullet; }
+  [[nodiscard]] SceneCollisionMethod method() const override { return SceneCollisionMethod::kBullet; }
 
  private:
   const ContactProbeSolver& probe_;

@@ -24,7 +24,7 @@
 //   tool (deeper than kInsideToleranceM) — it went through the tool, wherever it ended.
 // * inside: the node lies inside the tool volume deeper than kInsideToleranceM.
 // * crossed = wrong side OR through OR inside (a node counts once). Target: 0 (issue 5).
-// * endpoint_crossed (kept for comparison): the same count with the previous end-point-only
+// * endpoint_crossed (kept for comparison): the same count with an end-point-only
 //   side memory (no path test), which misreads a rim pass within one update as crossed.
 // * penetration: max(0, −signed distance to the tool volume); the max over nodes.
 #include <array>
@@ -90,7 +90,7 @@ struct CrossingSnapshot {
   int inside_nodes = 0;
   int through_nodes = 0;            ///< relative path crossed the mid-plane inside the tool since the last update
   int rim_passes = 0;               ///< changed side by passing the rim (outside the tool) within one update
-  int endpoint_crossed_nodes = 0;   ///< the previous end-point-only rule's crossed count (comparison only)
+  int endpoint_crossed_nodes = 0;   ///< the end-point-only rule's crossed count (comparison only)
   double max_penetration_m = 0.0;
 };
 
@@ -112,7 +112,7 @@ class CrossingTracker {
  private:
   ToolVolume volume_;
   std::vector<std::int8_t> side_;
-  std::vector<std::int8_t> endpoint_side_;          // the previous rule's memory (comparison only)
+  std::vector<std::int8_t> endpoint_side_;          // the end-point-only rule's memory (comparison only)
   std::vector<Eigen::Vector3d> previous_tool_m_;    // each node at the last update, tool frame
 };
 

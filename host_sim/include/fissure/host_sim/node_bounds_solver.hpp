@@ -10,8 +10,8 @@
 // loop that reads exactly those two positions of every node (the velocity update
 // v = (m_x − m_q)·(1 − kDP)/h). NodeBoundsSolver runs Bullet's solve with that loop taken over
 // and the bounds fused into it: one pass over the nodes instead of two. A separate pass after
-// the solve costs what the broad phase's own scan costs (measured 2026-11-22: +38-48 µs a step on
-// 10 242 nodes), since the nodes are cold again by then.
+// the solve costs what the broad phase's own scan costs (+38-48 µs a step on 10 242 nodes), since
+// the nodes are cold again by then.
 //
 // The simulation is bit-identical to Bullet's own solver (tests/host_sim/node_bounds_solver_test.cpp):
 // the same solvers run in the same order on the same data; only the no-op cluster passes move

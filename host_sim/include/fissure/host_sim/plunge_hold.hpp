@@ -28,7 +28,7 @@ inline constexpr double kHoldSettle_s = 0.05;
 /// Pose-matching coefficient (Bullet kMT) of the plunge ball: the collision unit tests'
 /// springy ball (tests/host_sim/soft_scene_fixture.hpp). The paper's shell (edge links, no
 /// pressure) has no restoring force: a plunge at ≥ 5 m/s snaps the cap into a dent that
-/// stays, and the held plate measures nothing (session 1: every paired cell at ≥ 10 m/s
+/// stays, and the held plate measures nothing (every paired cell at ≥ 10 m/s ends
 /// 'lost'). Pose matching pulls the cap back; collision and tunnelling are unchanged by it.
 inline constexpr double kPlungeShapeMatchingRatio = 0.05;
 

@@ -50,7 +50,7 @@ struct ProxyBuilderModel {
   std::array<int, kMaxProxyJaws> plane_count{0, 0};
   int jaw_count = 1;
   /// Which rt tool part a host jaw's contacts act on: kTool for a spatula, kJawA/kJawB for the
-  /// clamp's jaws (rt's convention: A is the jaw on the −e_c side, see rt_core/device_mapping.hpp).
+  /// clamp's jaws (rt's convention: A is the jaw on the −e_c side, see shared/device_mapping.hpp).
   std::array<ToolPart, kMaxProxyJaws> part_of_jaw{ToolPart::kTool, ToolPart::kTool};
 };
 

@@ -9,7 +9,9 @@
 // jaws face each other across local y.
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -21,7 +23,14 @@ namespace fissure::host {
 /// Which thin-body collision answers soft-vs-tool contact (BRIEF §3).
 enum class SceneCollisionMethod : std::uint8_t { kPaired, kRay, kBullet };
 
+/// Every method, in the order their names are listed to a user.
+inline constexpr std::array<SceneCollisionMethod, 3> kCollisionMethods{SceneCollisionMethod::kPaired, SceneCollisionMethod::kRay,
+                                                                       SceneCollisionMethod::kBullet};
+
+/// The method's name in scene files and on the command line: "paired", "ray", "bullet".
 [[nodiscard]] const char* to_string(SceneCollisionMethod method) noexcept;
+/// The method whose to_string() is `name`; nullopt for any other text (the caller says where it came from).
+[[nodiscard]] std::optional<SceneCollisionMethod> parse_collision_method(std::string_view name) noexcept;
 
 /// A rigid pose: position of the tool frame origin and its orientation, world frame.
 struct Pose {
@@ -112,21 +121,35 @@ struct ToolDescription {
   double pairing_ray_limit_m = 0.006;      ///< convex mesh: the pairing ray's length limit (paper Fig. 2); node per triangle
 };
 
-/// Hunt-Crossley F = k·xⁿ + λ·xⁿ·ẋ (BRIEF §4). per_unit_area (default): k, λ per m² of
-/// rest triangle area (mesh-independent); per_triangle: the paper's one force per triangle.
-enum class HuntCrossleyMode : std::uint8_t { kPerUnitArea, kPerTriangle };
+// What the Hunt-Crossley deformation x of a contacted triangle measures (docs/scenes.md,
+// [hunt_crossley] deformation_measure).
+enum class DeformationMeasure : std::uint8_t {
+  // Default. Per colliding soft node v of the triangle: x_v = max(0, n·(q − p_v,rest)), how far
+  // the tool face (a point q on it, outward normal n) has advanced along n past the node's rest
+  // position — for a node held on the face, its displacement from rest along n. Sliding along the
+  // face, wrapping round the rim and sag add no force, and x follows the tool pose exactly (no
+  // node noise); a node that enters contact where the face meets its rest position starts at
+  // x ≈ 0, and a held node's share of the force ramps down over release_distance as it
+  // separates, so taking or releasing one node changes the force continuously instead of by a
+  // whole triangle's worth.
+  kNormalDisplacement,
+  // The paper's: x = |centroid − rest centroid| per triangle (fidelity; counts tangential motion
+  // of the triangle as indentation, and the contacted share changes in thirds of a triangle).
+  kCentroidDistance,
+};
 
-/// What x measures (thin_body_collision.hpp DeformationMeasure): normal_displacement (default;
-/// per colliding node, along the tool face normal, from its rest position) or centroid_distance
-/// (the paper's |centroid − rest centroid| per triangle).
-enum class DeformationMeasureKind : std::uint8_t { kNormalDisplacement, kCentroidDistance };
-
-struct HuntCrossleyDescription {
-  HuntCrossleyMode mode = HuntCrossleyMode::kPerUnitArea;
-  DeformationMeasureKind deformation_measure = DeformationMeasureKind::kNormalDisplacement;
-  double exponent_n = 1.5;
-  double stiffness_k = 0.0;   ///< per_unit_area: Pa/mⁿ = N/m⁽ⁿ⁺²⁾; per_triangle: N/mⁿ
-  double damping_lambda = 0.0;  ///< per_unit_area: Pa·s/m⁽ⁿ⁺¹⁾; per_triangle: N·s/m⁽ⁿ⁺¹⁾
+// F = k·xⁿ + λ·xⁿ·ẋ for x ≥ 0, clamped to F ≥ 0 (BRIEF §4; Hunt & Crossley 1975), for every
+// deformed triangle with at least one colliding node; x per `measure`. A scene's [hunt_crossley]
+// table (docs/scenes.md) sets every field.
+struct HuntCrossleyParams {
+  double k = 2.0e5;       // per_unit_area: N/m^(n+2) (× rest area m² → N/mⁿ); else N/mⁿ per triangle
+  double lambda = 50.0;   // per_unit_area: N·s/m^(n+3); else N·s/m^(n+1) per triangle
+  double n = 1.5;         // exponent (1 flat punch, 3/2 Hertz)
+  // true (default, mode = "per_unit_area"): k and λ per unit area, each triangle weighted by its
+  // contacted share of its rest area (rest area × colliding vertices / 3), so refining the mesh
+  // converges the force; false (mode = "per_triangle"): the paper's plain per-triangle sum.
+  bool per_unit_area = true;
+  DeformationMeasure measure = DeformationMeasure::kNormalDisplacement;
 };
 
 struct SimulationDescription {
@@ -159,7 +182,7 @@ struct SceneDescription {
   GroundDescription ground{};
   SoftBodyDescription soft_body{};
   ToolDescription tool{};
-  HuntCrossleyDescription hunt_crossley{};
+  HuntCrossleyParams hunt_crossley{};
   DeviceMapping device_mapping{};
   HandScript hand{};
   TrajectoryDescription trajectory{};

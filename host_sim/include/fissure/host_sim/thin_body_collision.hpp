@@ -10,6 +10,7 @@
 //      displacements into soft.m_nodes[i].m_x / m_v, and computes the Hunt-Crossley force.
 // The tool's rigid body must NOT also collide with the soft body through Bullet (no SDF_RS contact
 // between them) for the paired / ray methods.
+#include <fissure/host_sim/scene_description.hpp>
 #include <fissure/host_sim/thin_tool.hpp>
 
 #include <Eigen/Core>
@@ -23,55 +24,6 @@ namespace fissure::host {
 
 struct SoftNodeBounds;  // node_bounds_solver.hpp
 
-enum class CollisionMethod { kPaired, kRay, kBullet };
-
-// What the Hunt-Crossley deformation x of a contacted triangle measures (docs/scenes.md).
-enum class DeformationMeasure {
-  // Default. Per colliding soft node v of the triangle: x_v = max(0, n·(q − p_v,rest)), how far
-  // the tool face (a point q on it, outward normal n) has advanced along n past the node's rest
-  // position — for a node held on the face, its displacement from rest along n. Sliding along the
-  // face, wrapping round the rim and sag add no force, and x follows the tool pose exactly (no
-  // node noise); a node that enters contact where the face meets its rest position starts at
-  // x ≈ 0, and a held node's share of the force ramps down over release_distance as it
-  // separates, so taking or releasing one node changes the force continuously instead of by a
-  // whole triangle's worth.
-  kNormalDisplacement,
-  // The paper's: x = |centroid − rest centroid| per triangle (fidelity; counts tangential motion
-  // of the triangle as indentation, and the contacted share changes in thirds of a triangle).
-  kCentroidDistance,
-};
-
-// Where normal_displacement's rest positions p_v,rest are (hunt_crossley_force.cpp).
-enum class RestFrame {
-  // Default. Fixed in the world where the rest state was taken (ThinBodyCollision::reset_rest_state).
-  kWorld,
-  // Carried with Bullet's pose-matching frame (btSoftBody::m_pose: com + rotation of the
-  // shape-matching fit; only with soft_body.shape_matching_ratio > 0, else as kWorld): x is the
-  // push from where the body's own shape matching pulls the node back to, so a ball rolling or
-  // sliding under a held tool is not counted as indentation. Not the default, measured on the
-  // bench's paired hold cells (tests/host_sim/hold_jitter_test.cpp, 128-face ball, kMT 0.05):
-  // the pose frame's com also sinks as the ball squashes against the ground, so the held force
-  // drops ~6× (plate 20 mm deep: 43.7 N -> 7.2 N) and the ball's own ringing after an impact
-  // (its com moving along n) becomes force jitter (plate 4 mm at 50 m/s: 2.3 % -> 8.1 %); the
-  // worst cells — the ball squirting out sideways from under the tool — stay bad either way
-  // (blade 50 m/s 514 % -> 345 %, convex 0.1 m/s 289 % -> 323 %).
-  kPoseMatched,
-};
-
-// F = k·xⁿ + λ·xⁿ·ẋ for x ≥ 0, clamped to F ≥ 0 (BRIEF §4; Hunt & Crossley 1975), for every
-// deformed triangle with at least one colliding node; x per `measure`.
-struct HuntCrossleyParams {
-  double k = 2.0e5;       // per_unit_area: N/m^(n+2) (× rest area m² → N/mⁿ); else N/mⁿ per triangle
-  double lambda = 50.0;   // per_unit_area: N·s/m^(n+3); else N·s/m^(n+1) per triangle
-  double n = 1.5;         // exponent (1 flat punch, 3/2 Hertz)
-  // true (default): k and λ per unit area, each triangle weighted by its contacted share of its rest
-  // area (rest area × colliding vertices / 3), so refining the mesh converges the force; false:
-  // the paper's plain per-triangle sum.
-  bool per_unit_area = true;
-  DeformationMeasure measure = DeformationMeasure::kNormalDisplacement;
-  RestFrame rest_frame = RestFrame::kWorld;  // normal_displacement only
-};
-
 struct ThinBodyCollisionParams {
   HuntCrossleyParams hunt_crossley;
   // Gap left between a displaced soft node and the tool face (keeps nodes strictly outside the
@@ -84,22 +36,12 @@ struct ThinBodyCollisionParams {
   // more than this: hysteresis against contact-set chatter when the soft body's own dynamics lift
   // a held node. Under normal_displacement its force share ramps (smoothstep) from 1 on the face
   // to 0 here, so this is also the width over which a separating node's force fades: 2 mm keeps
-  // the share's slope small against a held tool's ±40 µm encoder dither (0.2 mm, the former
-  // value, put ~7 N/mm of extra stiffness on the coarse ball: force steps of 15 % per dither step).
+  // the share's slope small against a held tool's ±40 µm encoder dither (0.2 mm puts ~7 N/mm
+  // of extra stiffness on the coarse ball: force steps of 15 % per dither step).
   double release_distance_m = 2.0e-3;
-  // Two off-by-default held-node options of earlier sessions were measured on bench collision's 32
-  // paired hold cells (tests/host_sim/hold_jitter_test.cpp) and on the tests, then deleted:
-  //  * retake_held_nodes — a held node pushed behind its plane (no tool node hitting it, its path
-  //    clear of the tool) put back on the face instead of released. On any plane within half a
-  //    thickness it changed clamp-sphere's squeeze (100 Hz proxy error 0.42 % -> 3.3 % of the
-  //    peak); restricted to rim planes it still leaves triangles sliced by a face-first plate's
-  //    rim (1 mm plate at 10 m/s with edge nodes: 3 at the end of the hold, 0 without);
-  //  * held_node_friction — Coulomb friction between a held node and the face (μ = kDF,
-  //    position-based) with an approach band made a slow press move the ball MORE (plate 1 mm
-  //    at 0.1 m/s: centre 13 mm aside at the end of the plunge vs 6 mm without, then squeezed
-  //    out from under the plate, force -> 0: hold jitter 2.9 % -> 146 %; blade 0.1 m/s 12 % ->
-  //    261 %) and the clamp-vessel proxy error went 1.27 % -> 6.0 % (bound 2 %).
-  // A held node behind its plane is released; the tool face is frictionless.
+  // A held node behind its plane is released, and the tool face is frictionless: putting such a
+  // node back on the face, or Coulomb friction between a held node and the face, make the bench's
+  // paired hold cells and the proxy tests worse (docs/decisions.md, "Held soft nodes").
   // ẋ is a finite difference of x filtered by a first-order low-pass with this cut-off
   // (time constant 1/(2π·fc), i.e. ≈1.6 ms lag at 100 Hz).
   double velocity_filter_cutoff_hz = 100.0;
@@ -174,7 +116,7 @@ class ThinBodyCollision {
   // nearest face would put a node the tool advanced past its mid-plane on the far side, through
   // the tool. Returns the number of nodes put out. Does not allocate.
   virtual int reseat(const ToolPose& previous, const ToolPose& current, btSoftBody& soft) = 0;
-  [[nodiscard]] virtual CollisionMethod method() const = 0;
+  [[nodiscard]] virtual SceneCollisionMethod method() const = 0;
 };
 
 // The soft body must have triangle faces (btSoftBody::m_faces); its rest state (rest centroids,

@@ -33,7 +33,7 @@
 //     below the device's own damping: a virtual damper behind the ping-pong latency and the
 //     filter lag is itself subject to the sampled-data limit b > K·T/2 + |B| (Colgate &
 //     Schenkel 1997).
-// Energy bound on the ramp (session 3): while E' is above the reference and F pushes the hand
+// Energy bound on the ramp: while E' is above the reference and F pushes the hand
 // out at power P (filtered velocity), r heads for at least the share that lets the force
 // return no more than the rest of a 10-margin budget over dissipation_time_s, and moves by at
 // least the step that removes it before ½·P·T·(remaining/step) exceeds that budget. At a
@@ -47,13 +47,12 @@
 // a force at standstill does no work.
 //
 // The force the controller works on is the one the device can render: the environment force
-// clamped to max_force_n (safety's clamp, which comes after). Until session 4 g acted on the
-// unclamped force, so against a 27 N contact rendered at 8 N the first 70 % of the reduction
-// changed nothing the hand felt (hc_lambda_over_k_1 stress case, t = 66.7 s: r = 1.1 N off
-// 12.3 N still sent 8 N; the next tick r = 4.6 N off 11.8 N took only 0.9 N off what went out)
-// and the prediction E' counted a force that never went out.
+// clamped to max_force_n (safety's clamp, which comes after). Acting on the unclamped force,
+// the first 70 % of a reduction against a 27 N contact rendered at 8 N would change nothing the
+// hand feels (hc_lambda_over_k_1 stress case), and the prediction E' would count a force that
+// never goes out.
 //
-// Energy bounding at speed (Kim & Ryu 2004, session 4). The ramps above act from the next tick
+// Energy bounding at speed (Kim & Ryu 2004). The ramps above act from the next tick
 // on, at most 2 N per tick; a hand that leaves a contact at 1–2 m/s while the full 8 N pushes it
 // out receives 8–16 mJ per tick, and the two commands already on their way (the ping-pong)
 // return that twice before any correction acts (hc_lambda_over_k_1: E from −2.8 to +32.5 mJ in
@@ -118,9 +117,9 @@ inline constexpr double kDefaultPassivityDampingRamp_s = 0.02;
 /// After a device fault [s]: the work done while safety brings the force back (its
 /// kDefaultFaultRampIn_s = 0.25 s ramp-in, after FaultConfig's 20 clean ticks ≤ 40 ms at
 /// 500 Hz) is counted in E and also reported as recovery_energy_j (the ramp pushes a hand
-/// that sank in while the force was off back out). Until session 3 the controller ignored it
-/// (so as not to hold the wall soft after a fault); that let each fault add energy nothing
-/// took back (4.7 J over 999 encoder jumps in the stress harness), so it now counts.
+/// that sank in while the force was off back out). It counts: ignored (so as not to hold the
+/// wall soft after a fault), each fault adds energy nothing takes back (4.7 J over 999 encoder
+/// jumps in the stress harness).
 inline constexpr double kPassivityRecoveryWindow_s = 0.3;
 /// Work done in one fault-recovery window that the force reduction g does not act on [J]:
 /// 10 default margins (4 mJ). Bringing the force back at a static hold necessarily pushes the

@@ -17,8 +17,8 @@
 // So a swap never makes a tick's step exceed max_step_n, nor the motion's own step when that
 // is larger; while the motion alone uses the whole budget in the walk's direction the offset
 // holds and walks out as soon as the motion slows (motion against the walk direction lets it
-// walk at the full rate). Until session 4 the walk always took max_step_n and added to m:
-// 0.062 N per tick in `fissure bench proxy` (500 Hz host: 0.05 N walk + 0.012 N of motion).
+// walk at the full rate). A walk that always takes max_step_n on top of m steps by 0.062 N per
+// tick in `fissure bench proxy` (500 Hz host: 0.05 N walk + 0.012 N of motion).
 #include <Eigen/Core>
 
 namespace fissure::rt {

@@ -1,8 +1,7 @@
 #pragma once
 // Pipeline stage: take the newest contact proxy from the host (wait-free try_fetch on the
 // LatestValueExchange), validate it, keep it double-buffered so that the previous proxy stays
-// readable for the swap blend (proxy_blend.hpp), and extrapolate each patch's plane in time
-// between host updates.
+// readable for the swap blend (proxy_blend.hpp).
 //   * invalid (validate() fails, or the host did not set kProxyValid): rejected, counted,
 //     kFaultProxyInvalid latched — the contact force fades out (staleness.hpp) until a valid
 //     proxy arrives;
@@ -10,19 +9,7 @@
 //     counted; it neither refreshes the proxy age nor faults.
 // Proxy age is measured on rt_core's clock from the tick that accepted it, so it is right
 // even when the host's simulation clock is another machine's.
-//
-// Why extrapolate (optional, off by default — see ProxyExtrapolation for the measurement): when
-// the host's soft body keeps moving while the tool holds still (on spatula-sphere early in
-// session 2 the host force rose by ~20 N/s at a fixed tool pose after the press), a proxy frozen
-// at its reference pose is wrong by (force rate × host period) just before the next one arrives. Each patch's surface speed along its normal is
-// estimated from two consecutive proxies (matched by tool part and normal; host times from
-// the same host clock, so no clock mapping is needed), passed through a minmod limiter against
-// the previous estimate (a one-off jump — contact lost, a patch appearing — has no trend behind
-// it and gives 0; a steady drift gives the smaller of the two rates), and the plane is moved by
-// speed × min(age, host period): never further than the host itself moved it in one period.
-// HAPI (H3D) extrapolates its transferred shapes between transfers the same way (BRIEF §5).
-// The rendered (extrapolated) proxies are what active_proxy()/previous_proxy() return; the
-// proxies as received are kept beside them.
+// A proxy is rendered exactly as the host sent it, held at its reference pose until the next.
 #include <array>
 #include <cstdint>
 
@@ -36,38 +23,13 @@ namespace fissure::rt {
 
 enum class ProxyIntake : std::uint8_t { kNothingNew, kAccepted, kRejected, kOutOfOrder };
 
-/// How patch planes are extrapolated between host updates (const model).
-/// Off by default: measured with the host as of the end of session 2 (`fissure bench proxy`,
-/// column extrap_v_h% against mdl_v_hst%; PaperSceneProxy held-proxy test), extrapolating made the
-/// held proxy slightly WORSE (spatula-sphere at a 100 Hz host: 0.68 % vs 0.49 % RMS; scripted
-/// trajectory: 0.378 % vs 0.292 %): that host's force no longer drifts at a still pose, and what
-/// the plane offset does between proxies is noise more than trend. Earlier in the session the host
-/// force crept by ~20 N/s at a still pose, which is what this was built for; keep it measured.
-struct ProxyExtrapolation {
-  bool enabled = false;
-  /// Two patches of consecutive proxies are "the same contact" when they act on the same tool
-  /// part and their normals are within ~10° (cos 10° = 0.985): a tool face's patch turns far
-  /// less than that in one host period of a soft-tissue contact.
-  double match_min_cosine = 0.985;
-  /// Host periods longer than this do not give a speed [s]: the proxies are too far apart for
-  /// a linear trend (100 ms = the stale bound, ProxyConfig::stale_after_s).
-  double max_baseline_s = 0.1;
-  /// Surface speeds are clamped to this [m/s]: hand motion is < 1 m/s; a faster "surface" is a
-  /// host discontinuity, not motion.
-  double max_surface_speed_m_per_s = 1.0;
-};
-
 struct ProxyState {
-  std::array<ContactProxy, 2> buffers{};   ///< as received: [active] in use; [1 − active] the previous one
-  std::array<ContactProxy, 2> rendered{};  ///< the same, planes extrapolated to the current tick
-  /// Per buffer and patch: surface speed along the patch normal [m/s] (> 0: the surface advances
-  /// onto the tool), raw (for the next limiter) and limited (used), and the host period it spans.
-  std::array<std::array<double, kMaxContactPatches>, 2> raw_speed_m_per_s{};
-  std::array<std::array<double, kMaxContactPatches>, 2> speed_m_per_s{};
-  std::array<TimeNs, 2> horizon_ns{};
+  std::array<ContactProxy, 2> buffers{};  ///< [active] in use; [1 − active] the previous one (see have_previous)
   int active = 0;
   bool have_proxy = false;                ///< a valid proxy was ever accepted
-  bool have_previous = false;             ///< rendered[1 − active] holds the proxy before it (at now)
+  /// buffers[1 − active] holds the proxy before the active one: true from the tick that accepted
+  /// the active proxy until the next fetch, which writes its candidate into that buffer.
+  bool have_previous = false;
   bool invalid_latched = false;           ///< newest proxy from the host was invalid
   TimeNs accepted_at_ns = 0;              ///< rt time of the tick that accepted the active proxy
   std::uint64_t accepted_count = 0;
@@ -76,19 +38,15 @@ struct ProxyState {
   ProxyError last_error = ProxyError::kNone;
 };
 
-/// Wait-free: at most one try_fetch (one atomic exchange + a copy) and one validate(); moves
-/// the active proxy's planes to `now_ns` every call (also when nothing new came).
-ProxyIntake take_latest_proxy(ProxyExchange& exchange, ProxyState& state, TimeNs now_ns,
-                              const ProxyExtrapolation& extrapolation = {}) noexcept;
+/// Wait-free: at most one try_fetch (one atomic exchange + a copy) and one validate().
+ProxyIntake take_latest_proxy(ProxyExchange& exchange, ProxyState& state, TimeNs now_ns) noexcept;
 
-/// The proxy to evaluate this tick (extrapolated to the tick of the last take_latest_proxy).
-inline const ContactProxy& active_proxy(const ProxyState& state) noexcept { return state.rendered[state.active]; }
-/// The proxy before it, extrapolated to the same tick (valid when have_previous).
+/// The proxy to evaluate this tick.
+inline const ContactProxy& active_proxy(const ProxyState& state) noexcept { return state.buffers[state.active]; }
+/// The proxy before it (valid when have_previous).
 inline const ContactProxy& previous_proxy(const ProxyState& state) noexcept {
-  return state.rendered[1 - state.active];
+  return state.buffers[1 - state.active];
 }
-/// The active proxy exactly as the host sent it.
-inline const ContactProxy& received_proxy(const ProxyState& state) noexcept { return state.buffers[state.active]; }
 
 /// Age of the active proxy [ns] (0 when there is none).
 inline TimeNs proxy_age_ns(const ProxyState& state, TimeNs now_ns) noexcept {

@@ -13,8 +13,8 @@
 // part of the rendered environment, and like any rendered spring it returns energy it never
 // stored when it is ramped in around a hand that is already deep in it — after an encoder
 // jump to a position 4–9 cm outside the workspace (stress case encoder_jumps: 8 N ramped in,
-// 26 mJ in 80 ms) — which the controller must be able to take back. Until session 3 it was
-// added here, after the controller, where nothing could.
+// 26 mJ in 80 ms) — which the controller must be able to take back; added after the
+// controller, that energy would reach the hand where nothing can take it back.
 #include <cstdint>
 
 #include <Eigen/Core>

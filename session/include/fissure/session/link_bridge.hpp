@@ -1,5 +1,5 @@
 #pragma once
-// The link bridge of a split deployment (issue 6, docs/deployment.md): it pumps between the
+// The link bridge of a split deployment (docs/deployment.md): it pumps between the
 // in-process exchanges rt_core and the host already use (DeviceStateExchange,
 // ProxyExchange) and a wire LinkEndpoint (shared/wire_link.hpp). It runs on a non-RT
 // service thread (or the host's own loop), so the rt tick never touches a socket and neither

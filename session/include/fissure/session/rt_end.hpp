@@ -40,7 +40,9 @@ struct RtEndOutcome {
   std::uint64_t frames_discarded = 0;
   std::uint64_t messages_discarded = 0;
   std::uint64_t host_restarts = 0;
-  std::uint64_t fault_ticks = 0;        ///< ticks with a fault bit set (docs/session.md)
+  std::uint64_t device_fault_ticks = 0; ///< ticks with a device-side fault (rt_core/faults.hpp)
+  std::uint64_t proxy_stale_ticks = 0;  ///< ticks without a fresh proxy: expected once the host stops
+  std::uint64_t proxies_rejected = 0;   ///< proxies rt_core refused as invalid
   bool interrupted = false;
 };
 

@@ -36,9 +36,6 @@ struct HostStatus {
   bool soft_everted = false;          ///< soft_volume_ratio < 0 after some step so far (latched)
 };
 
-/// The proxy builder's model for a scene's host simulation (planes per jaw, jaw → rt part).
-host::ProxyBuilderModel proxy_model_for(const host::SceneDescription& scene, const host::HostSimulation& sim);
-
 class SessionHost {
  public:
   /// `scene` must outlive the host. Builds the simulation (throws what HostSimulation throws).

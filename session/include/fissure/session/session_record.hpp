@@ -1,6 +1,6 @@
 #pragma once
 // What a `fissure run` session leaves behind: a per-tick CSV trace (rt telemetry + the newest
-// host status), the summary figures issue 6 names (crossed_nodes_max, faults, overruns,
+// host status), the summary figures docs/session.md explains (crossed_nodes_max, faults, overruns,
 // force_max_n, proxy_age_ms {median, p99}, energy_j) and a status line. Runs on the session's
 // main thread (not the rt thread): it may allocate and write files.
 #include <cstdint>

@@ -41,7 +41,7 @@ struct SessionOptions {
   /// energy comes from: with it off the summary's energy_j is the rendered contact's own.
   bool passivity_controller = true;
   bool status_line = true;
-  /// The view (issue 8): a live window (--view; no display → one line, the session runs on)
+  /// The view: a live window (--view; no display → one line, the session runs on)
   /// and/or PNG frames of every frame_every-th host step into frames_dir (headless EGL, a
   /// writer thread; real time never waits for it and counts the frames it dropped, lockstep
   /// waits so the frames are the same on every run). Neither changes the physics.

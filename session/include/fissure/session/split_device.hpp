@@ -1,8 +1,8 @@
 #pragma once
-// Pieces `fissure rt`, `fissure host` and `fissure hil latency` share (issue 6, split
-// deployment): opening the device an rt end drives, a device decorator that times each
-// exchange (the HIL "device round trip"), and a clock decorator that remembers when the rt
-// loop last woke (so the HIL benchmark can time the tick without touching RtLoop).
+// Pieces the ends of a split deployment and `fissure hil latency` share: opening the device an
+// rt end drives, a device decorator that times each exchange (the HIL "device round trip"), and
+// a clock decorator that remembers when the rt loop last woke (so the HIL benchmark can time
+// the tick without touching RtLoop).
 #include <atomic>
 #include <memory>
 #include <optional>

@@ -87,7 +87,7 @@ struct DeviceState {
   TimeNs sample_time_ns = 0;         ///< when the encoders were read (shared timeline)
   Vec3 position_device_m{};          ///< end-effector position, device frame [m]
   Vec3 velocity_device_m_per_s{};    ///< filtered end-effector velocity, device frame [m/s]
-  double closing_axis_m = 0.0;       ///< clamp mode: displacement along the mapped closing axis [m]
+  double closing_axis_m = 0.0;       ///< clamp mode: rt::jaw_closing_m of this sample [m], the host's jaw closing; else 0
   std::uint32_t buttons = 0;         ///< bit i = grip button i pressed (Falcon: 4 buttons)
   std::uint32_t status_flags = 0;    ///< DeviceStatusBits; bits 24..31: position epoch (position_epoch())
 };

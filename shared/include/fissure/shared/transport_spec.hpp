@@ -1,5 +1,5 @@
 #pragma once
-// The `--transport` option both commands take (issue 6): `inproc`, `can:IFACE`,
+// The `--transport` option both commands take: `inproc`, `can:IFACE`,
 // `udp:HOST:PORT`. One convention for UDP on both ends: HOST:PORT is the rt box's address.
 // The rt end binds it and answers whoever talks to it; the host end binds an ephemeral port
 // and sends to it. Setup-time code: may allocate and throws TransportError.

@@ -1,5 +1,5 @@
 #pragma once
-// What the view draws, split in two (issue 8):
+// What the view draws, split in two:
 //   * RenderModel — the const *model* of a scene's picture, built ONCE after the soft body has
 //     settled: soft triangles, the soft rest shape (for the deformation colour map), the tool
 //     parts' meshes, the ground, where the camera looks. Handed to the view before it starts and

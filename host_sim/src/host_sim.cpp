@@ -1,1 +1,0 @@
-namespace fissure::host {}  // the host_sim issue fills this module
