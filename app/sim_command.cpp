@@ -80,73 +80,14 @@ std::optional<host::SceneCollisionMethod> parse_method(const std::string& name) 
   throw CLI::ValidationError("--method", "must be paired, ray or bullet (got '" + name + "')");
 }
 
-void run_sim(const SimOptions& options) {
-  if (!options.write_meshes_dir.empty()) {
-    write_meshes(options.write_meshes_dir);
-    if (options.scene.empty()) return;
-  }
-  if (options.scene.empty()) throw CLI::ValidationError("SCENE", "a scene name or file is required");
-  const auto method = parse_method(options.method);
-  host::SceneDescription scene;
-  try {
-    scene = host::load_scene(host::resolve_scene_path(options.scene));
-  } catch (const host::SceneError& e) {
-    throw CommandError(e.what());
-  }
-  std::unique_ptr<host::HostSimulation> sim;
-  try {
-    sim = std::make_unique<host::HostSimulation>(scene, method);
-  } catch (const std::exception& e) {
-    throw CommandError(scene.source_path + ": cannot build the simulation: " + e.what());
-  }
-  std::ofstream csv;
-  if (!options.csv_path.empty()) {
-    csv.open(options.csv_path);
-    if (!csv) throw CommandError("cannot write the CSV trace '" + options.csv_path + "'");
-    csv << "time_s,tool_x_m,tool_y_m,tool_z_m,jaw_gap_m,force_x_n,force_y_n,force_z_n,jaw_a_force_n,jaw_b_force_n,contacts,"
-           "crossed_nodes,max_penetration_m,step_us,collision_us\n";
-    csv.precision(9);
-  }
-  const Eigen::AlignedBox3d before = sim->soft_bounds_world_m();
-  sim->settle(options.settle_seconds);
-  const Eigen::AlignedBox3d settled = sim->soft_bounds_world_m();
-  std::printf("soft body bounds y: %.4f .. %.4f m at load, %.4f .. %.4f m after settling %.2f s\n", before.min().y(), before.max().y(),
-              settled.min().y(), settled.max().y(), options.settle_seconds);
-  const double duration_s = options.seconds > 0.0 ? options.seconds : host::trajectory_duration_s(scene);
-  const double dt = scene.simulation.time_step_s;
-  const long steps = std::max(1L, std::lround(duration_s / dt));
-  // --frames: PNGs of every frame_every-th step, drawn by viewer/'s writer thread from the
-  // settled body's picture model. Offline, so each frame is waited for (none dropped).
-  std::unique_ptr<viewer::SessionView> view;
-  if (!options.frames_dir.empty()) {
-    viewer::SessionViewOptions vo;
-    vo.frames_dir = options.frames_dir;
-    vo.frame_every_steps = options.frame_every;
-    vo.frame_width_px = options.width_px;
-    vo.frame_height_px = options.height_px;
-    vo.wait_for_frames = true;
-    vo.expected_host_steps = static_cast<std::size_t>(steps);
-    std::string error, notice;
-    try {
-      view = viewer::SessionView::start(viewer::make_render_model(*sim), vo, error, notice);
-    } catch (const std::exception& e) {
-      throw CommandError(std::string("--frames: ") + e.what());
-    }
-    if (!view) throw CommandError("--frames: " + error);
-  }
-  std::printf("scene %s: %s, method %s, %d faces / %d nodes, %ld steps of %.3g ms\n", scene.name.c_str(), scene.description.c_str(),
-              host::to_string(sim->method()), sim->soft_face_count(), sim->soft_node_count(), steps, dt * 1e3);
-  SimProgress progress("sim " + scene.name, steps);
+/// What a headless run accumulates over its steps.
+struct SimFigures {
   std::vector<double> step_s, collision_s, force_in_contact;
-  step_s.reserve(static_cast<std::size_t>(steps));
-  collision_s.reserve(static_cast<std::size_t>(steps));
   int crossed_max = 0, contacts_max = 0, wrong_side_max = 0, inside_max = 0;
   double penetration_max = 0.0, force_max = 0.0;
   bool finite = true;
-  for (long i = 0; i < steps; ++i) {
-    const host::TrajectorySample target = sim->scripted_target();
-    const host::HostStepResult& r = sim->step(host::to_tool_pose(target.pose), target.jaw_gap_m);
-    if (view) view->on_host_step(*sim, nullptr);
+
+  void add(const host::HostStepResult& r) {
     step_s.push_back(r.times.total_s);
     collision_s.push_back(r.times.collision_s);
     const double f = r.force_on_tool_world_n.norm();
@@ -158,16 +99,148 @@ void run_sim(const SimOptions& options) {
     inside_max = std::max(inside_max, r.crossing.inside_nodes);
     contacts_max = std::max(contacts_max, r.contact_count);
     penetration_max = std::max(penetration_max, r.crossing.max_penetration_m);
-    if (csv.is_open()) {
-      const auto& p = sim->tool_pose().position_world_m;
-      csv << r.time_s << ',' << p.x() << ',' << p.y() << ',' << p.z() << ',' << r.jaw_gap_m << ',' << r.force_on_tool_world_n.x() << ','
-          << r.force_on_tool_world_n.y() << ',' << r.force_on_tool_world_n.z() << ',' << r.part_force_world_n[0].norm() << ','
-          << (r.part_count > 1 ? r.part_force_world_n[1].norm() : 0.0) << ',' << r.contact_count << ',' << r.crossing.crossed_nodes << ','
-          << r.crossing.max_penetration_m << ',' << r.times.total_s * 1e6 << ',' << r.times.collision_s * 1e6 << '\n';
-    }
+  }
+  [[nodiscard]] double mean_in_contact() const {
+    double mean = 0.0;
+    for (double f : force_in_contact) mean += f;
+    return force_in_contact.empty() ? 0.0 : mean / static_cast<double>(force_in_contact.size());
+  }
+  [[nodiscard]] double std_in_contact() const {
+    const double mean = mean_in_contact();
+    double var = 0.0;
+    for (double f : force_in_contact) var += (f - mean) * (f - mean);
+    return force_in_contact.size() > 1 ? std::sqrt(var / static_cast<double>(force_in_contact.size() - 1)) : 0.0;
+  }
+};
+
+std::ofstream open_csv_trace(const std::string& path) {
+  std::ofstream csv;
+  if (path.empty()) return csv;
+  csv.open(path);
+  if (!csv) throw CommandError("cannot write the CSV trace '" + path + "'");
+  csv << "time_s,tool_x_m,tool_y_m,tool_z_m,jaw_gap_m,force_x_n,force_y_n,force_z_n,jaw_a_force_n,jaw_b_force_n,contacts,"
+         "crossed_nodes,max_penetration_m,step_us,collision_us\n";
+  csv.precision(9);
+  return csv;
+}
+
+void write_csv_row(std::ofstream& csv, const host::HostSimulation& sim, const host::HostStepResult& r) {
+  const auto& p = sim.tool_pose().position_world_m;
+  csv << r.time_s << ',' << p.x() << ',' << p.y() << ',' << p.z() << ',' << r.jaw_gap_m << ',' << r.force_on_tool_world_n.x() << ','
+      << r.force_on_tool_world_n.y() << ',' << r.force_on_tool_world_n.z() << ',' << r.part_force_world_n[0].norm() << ','
+      << (r.part_count > 1 ? r.part_force_world_n[1].norm() : 0.0) << ',' << r.contact_count << ',' << r.crossing.crossed_nodes << ','
+      << r.crossing.max_penetration_m << ',' << r.times.total_s * 1e6 << ',' << r.times.collision_s * 1e6 << '\n';
+}
+
+// --frames: PNGs of every frame_every-th step, drawn by viewer/'s writer thread from the
+// settled body's picture model. Offline, so each frame is waited for (none dropped).
+std::unique_ptr<viewer::SessionView> start_frames(const SimOptions& options, host::HostSimulation& sim, long steps) {
+  if (options.frames_dir.empty()) return nullptr;
+  viewer::SessionViewOptions vo;
+  vo.frames_dir = options.frames_dir;
+  vo.frame_every_steps = options.frame_every;
+  vo.frame_width_px = options.width_px;
+  vo.frame_height_px = options.height_px;
+  vo.wait_for_frames = true;
+  vo.expected_host_steps = static_cast<std::size_t>(steps);
+  std::string error, notice;
+  std::unique_ptr<viewer::SessionView> view;
+  try {
+    view = viewer::SessionView::start(viewer::make_render_model(sim), vo, error, notice);
+  } catch (const std::exception& e) {
+    throw CommandError(std::string("--frames: ") + e.what());
+  }
+  if (!view) throw CommandError("--frames: " + error);
+  return view;
+}
+
+void print_summary(const SimFigures& f) {
+  std::printf("crossed nodes max %d (wrong side %d, inside %d), max penetration %.4f mm, contacts max %d\n", f.crossed_max,
+              f.wrong_side_max, f.inside_max, f.penetration_max * 1e3, f.contacts_max);
+  std::printf("force |F| max %.4f N, mean in contact %.4f N (std %.4f N, %zu steps), finite %s\n", f.force_max, f.mean_in_contact(),
+              f.std_in_contact(), f.force_in_contact.size(), f.finite ? "yes" : "NO");
+  std::printf("step time median %.1f us, p99 %.1f us; collision median %.1f us, p99 %.1f us\n", sim_quantile(f.step_s, 0.5) * 1e6,
+              sim_quantile(f.step_s, 0.99) * 1e6, sim_quantile(f.collision_s, 0.5) * 1e6, sim_quantile(f.collision_s, 0.99) * 1e6);
+}
+
+void write_json(const SimOptions& options, const host::SceneDescription& scene, const host::HostSimulation& sim, long steps,
+                const SimFigures& f, const std::optional<viewer::SessionViewStats>& frames) {
+  nlohmann::json j;
+  j["scene"] = scene.name;
+  j["scene_file"] = scene.source_path;
+  j["method"] = host::to_string(sim.method());
+  j["faces"] = sim.soft_face_count();
+  j["nodes"] = sim.soft_node_count();
+  j["time_step_s"] = scene.simulation.time_step_s;
+  j["steps"] = steps;
+  j["settle_s"] = options.settle_seconds;
+  j["crossed_nodes_max"] = f.crossed_max;
+  j["wrong_side_nodes_max"] = f.wrong_side_max;
+  j["inside_nodes_max"] = f.inside_max;
+  j["max_penetration_m"] = f.penetration_max;
+  j["contacts_max"] = f.contacts_max;
+  j["force"] = {{"max_n", f.force_max}, {"mean_in_contact_n", f.mean_in_contact()}, {"std_in_contact_n", f.std_in_contact()},
+                {"steps_in_contact", f.force_in_contact.size()}, {"all_finite", f.finite}};
+  j["step_time_us"] = {{"median", sim_quantile(f.step_s, 0.5) * 1e6}, {"p99", sim_quantile(f.step_s, 0.99) * 1e6}};
+  j["collision_time_us"] = {{"median", sim_quantile(f.collision_s, 0.5) * 1e6}, {"p99", sim_quantile(f.collision_s, 0.99) * 1e6}};
+  if (frames) {
+    j["frames"] = {{"dir", options.frames_dir}, {"every_steps", options.frame_every}, {"written", frames->frames_written},
+                   {"dropped", frames->frames_dropped}, {"frame_ms_median", sim_quantile(frames->frame_s, 0.5) * 1e3}};
+  }
+  j["machine"] = sim_machine_info();
+  std::ofstream out(options.json_path);
+  if (!out) throw CommandError("cannot write the JSON summary '" + options.json_path + "'");
+  out << j.dump(2) << '\n';
+}
+
+std::unique_ptr<host::HostSimulation> open_simulation(const SimOptions& options, host::SceneDescription& scene) {
+  const auto method = parse_method(options.method);
+  try {
+    scene = host::load_scene(host::resolve_scene_path(options.scene));
+  } catch (const host::SceneError& e) {
+    throw CommandError(e.what());
+  }
+  try {
+    return std::make_unique<host::HostSimulation>(scene, method);
+  } catch (const std::exception& e) {
+    throw CommandError(scene.source_path + ": cannot build the simulation: " + e.what());
+  }
+}
+
+void run_sim(const SimOptions& options) {
+  if (!options.write_meshes_dir.empty()) {
+    write_meshes(options.write_meshes_dir);
+    if (options.scene.empty()) return;
+  }
+  if (options.scene.empty()) throw CLI::ValidationError("SCENE", "a scene name or file is required");
+  host::SceneDescription scene;
+  const std::unique_ptr<host::HostSimulation> sim = open_simulation(options, scene);
+  std::ofstream csv = open_csv_trace(options.csv_path);
+  const Eigen::AlignedBox3d before = sim->soft_bounds_world_m();
+  sim->settle(options.settle_seconds);
+  const Eigen::AlignedBox3d settled = sim->soft_bounds_world_m();
+  std::printf("soft body bounds y: %.4f .. %.4f m at load, %.4f .. %.4f m after settling %.2f s\n", before.min().y(), before.max().y(),
+              settled.min().y(), settled.max().y(), options.settle_seconds);
+  const double duration_s = options.seconds > 0.0 ? options.seconds : host::trajectory_duration_s(scene);
+  const double dt = scene.simulation.time_step_s;
+  const long steps = std::max(1L, std::lround(duration_s / dt));
+  std::unique_ptr<viewer::SessionView> view = start_frames(options, *sim, steps);
+  std::printf("scene %s: %s, method %s, %d faces / %d nodes, %ld steps of %.3g ms\n", scene.name.c_str(), scene.description.c_str(),
+              host::to_string(sim->method()), sim->soft_face_count(), sim->soft_node_count(), steps, dt * 1e3);
+  SimProgress progress("sim " + scene.name, steps);
+  SimFigures figures;
+  figures.step_s.reserve(static_cast<std::size_t>(steps));
+  figures.collision_s.reserve(static_cast<std::size_t>(steps));
+  for (long i = 0; i < steps; ++i) {
+    const host::TrajectorySample target = sim->scripted_target();
+    const host::HostStepResult& r = sim->step(host::to_tool_pose(target.pose), target.jaw_gap_m);
+    if (view) view->on_host_step(*sim, nullptr);
+    figures.add(r);
+    if (csv.is_open()) write_csv_row(csv, *sim, r);
     if (i % 50 == 0 || i + 1 == steps) {
       char status[160];
-      std::snprintf(status, sizeof status, "t %.3f s |F| %.3f N contacts %d crossed %d", r.time_s, f, r.contact_count, r.crossing.crossed_nodes);
+      std::snprintf(status, sizeof status, "t %.3f s |F| %.3f N contacts %d crossed %d", r.time_s, r.force_on_tool_world_n.norm(),
+                    r.contact_count, r.crossing.crossed_nodes);
       progress.update(i + 1, status);
     }
   }
@@ -180,46 +253,8 @@ void run_sim(const SimOptions& options) {
                 static_cast<unsigned long long>(frames->frames_written), options.frames_dir.c_str(), options.frame_every,
                 sim_quantile(frames->frame_s, 0.5) * 1e3, frames->gl_description.c_str());
   }
-  double mean = 0.0, var = 0.0;
-  for (double f : force_in_contact) mean += f;
-  mean = force_in_contact.empty() ? 0.0 : mean / static_cast<double>(force_in_contact.size());
-  for (double f : force_in_contact) var += (f - mean) * (f - mean);
-  const double stddev = force_in_contact.size() > 1 ? std::sqrt(var / static_cast<double>(force_in_contact.size() - 1)) : 0.0;
-  const double median_us = sim_quantile(step_s, 0.5) * 1e6, p99_us = sim_quantile(step_s, 0.99) * 1e6;
-  std::printf("crossed nodes max %d (wrong side %d, inside %d), max penetration %.4f mm, contacts max %d\n", crossed_max, wrong_side_max,
-              inside_max, penetration_max * 1e3, contacts_max);
-  std::printf("force |F| max %.4f N, mean in contact %.4f N (std %.4f N, %zu steps), finite %s\n", force_max, mean, stddev,
-              force_in_contact.size(), finite ? "yes" : "NO");
-  std::printf("step time median %.1f us, p99 %.1f us; collision median %.1f us, p99 %.1f us\n", median_us, p99_us,
-              sim_quantile(collision_s, 0.5) * 1e6, sim_quantile(collision_s, 0.99) * 1e6);
-  if (!options.json_path.empty()) {
-    nlohmann::json j;
-    j["scene"] = scene.name;
-    j["scene_file"] = scene.source_path;
-    j["method"] = host::to_string(sim->method());
-    j["faces"] = sim->soft_face_count();
-    j["nodes"] = sim->soft_node_count();
-    j["time_step_s"] = dt;
-    j["steps"] = steps;
-    j["settle_s"] = options.settle_seconds;
-    j["crossed_nodes_max"] = crossed_max;
-    j["wrong_side_nodes_max"] = wrong_side_max;
-    j["inside_nodes_max"] = inside_max;
-    j["max_penetration_m"] = penetration_max;
-    j["contacts_max"] = contacts_max;
-    j["force"] = {{"max_n", force_max}, {"mean_in_contact_n", mean}, {"std_in_contact_n", stddev},
-                  {"steps_in_contact", force_in_contact.size()}, {"all_finite", finite}};
-    j["step_time_us"] = {{"median", median_us}, {"p99", p99_us}};
-    j["collision_time_us"] = {{"median", sim_quantile(collision_s, 0.5) * 1e6}, {"p99", sim_quantile(collision_s, 0.99) * 1e6}};
-    if (frames) {
-      j["frames"] = {{"dir", options.frames_dir}, {"every_steps", options.frame_every}, {"written", frames->frames_written},
-                     {"dropped", frames->frames_dropped}, {"frame_ms_median", sim_quantile(frames->frame_s, 0.5) * 1e3}};
-    }
-    j["machine"] = sim_machine_info();
-    std::ofstream out(options.json_path);
-    if (!out) throw CommandError("cannot write the JSON summary '" + options.json_path + "'");
-    out << j.dump(2) << '\n';
-  }
+  print_summary(figures);
+  if (!options.json_path.empty()) write_json(options, scene, *sim, steps, figures, frames);
 }
 
 }  // namespace
