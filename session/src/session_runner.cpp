@@ -156,6 +156,290 @@ host::SceneDescription scene_at_host_rate(const host::SceneDescription& scene, d
   return out;
 }
 
+namespace {
+
+/// What the session's set-up builds and both run modes use.
+struct SessionParts {
+  const SessionOptions& options;
+  const host::SceneDescription& scene;
+  const rt::RtModel& model;
+  SessionHost& host;
+  SessionRecorder& recorder;
+  StatusPrinter& status;
+  viewer::SessionView* view;        ///< null without --view/--frames
+  RtFiguresTracker rt_figures{};
+  double duration_s = 0.0;          ///< 0: until interrupted
+  [[nodiscard]] double host_dt_s() const { return scene.simulation.time_step_s; }
+};
+
+/// What a run mode reports beside the recorder's figures.
+struct RunFigures {
+  std::string device_name;
+  double session_time_s = 0.0;
+  std::uint64_t proxies_rejected = 0;
+  std::uint64_t host_late_steps = 0;
+  std::uint64_t host_status_dropped = 0;
+  double wakeup_median_us = 0.0;
+  double wakeup_p99_us = 0.0;
+  double wakeup_max_us = 0.0;
+  double max_tick_us = 0.0;
+  nlohmann::json extra;             ///< mode-specific keys added to the summary
+};
+
+// The view's picture model is built from the settled body (its rest shape is what the
+// deformation colours are measured from), before any thread steps the simulation, and its
+// sinks (window, frame writer) start before the first tick: Mesa maps and locks LLVM when it
+// starts, which stalls a running rt loop for tens of ms (docs/decisions.md); started here,
+// that cost lands in the rt set-up (summary.json's rt_setup.seconds), not in the session.
+std::unique_ptr<viewer::SessionView> start_view(const SessionOptions& options, SessionHost& host, double expected_s,
+                                                double host_dt_s) {
+  if (!options.view && options.frames_dir.empty()) return nullptr;
+  viewer::RenderModel view_model;
+  try {
+    view_model = viewer::make_render_model(host.simulation());
+  } catch (const std::exception& e) {
+    throw SessionError(std::string("--view/--frames: ") + e.what());
+  }
+  viewer::SessionViewOptions vo;
+  vo.window = options.view;
+  vo.window_options.width_px = options.frame_width_px;
+  vo.window_options.height_px = options.frame_height_px;
+  vo.window_options.method_switching = false;  // a session cannot swap its method under the hand
+  vo.window_options.screenshot_dir = options.out_dir;
+  vo.frames_dir = options.frames_dir;
+  vo.frame_every_steps = options.frame_every;
+  vo.frame_width_px = options.frame_width_px;
+  vo.frame_height_px = options.frame_height_px;
+  vo.wait_for_frames = options.lockstep;
+  vo.expected_host_steps = static_cast<std::size_t>(expected_s / host_dt_s);
+  std::string error;
+  std::string notice;
+  std::unique_ptr<viewer::SessionView> view = viewer::SessionView::start(view_model, vo, error, notice);
+  if (!notice.empty()) std::fprintf(stderr, "%s\n", notice.c_str());
+  if (!view) throw SessionError("--frames: " + error);
+  return view;
+}
+
+/// Lockstep: one thread on a LockstepClock — N rt ticks, one host step, repeat.
+void run_lockstep(SessionParts& parts, const falcon::SimFalconConfig& sim_config, RunFigures& out) {
+  LockstepClock clock(0);
+  falcon::SimFalcon device(sim_config, clock);
+  out.device_name = device.name();
+  RtStack rt(parts.model, device, clock);
+  rt::RtLoop& loop = rt.loop();
+  RtChannels& channels = rt.channels();
+  const double host_dt_s = parts.host_dt_s();
+  const double ratio = host_dt_s / parts.model.period_s;
+  const auto ticks_per_host = static_cast<std::uint64_t>(std::llround(ratio));
+  if (ticks_per_host < 1 || std::abs(ratio - static_cast<double>(ticks_per_host)) > 1e-6 * ratio) {
+    throw SessionError("--lockstep: the host period (" + std::to_string(host_dt_s * 1e3) +
+                       " ms) must be a whole number of rt periods (" + std::to_string(parts.model.period_s * 1e3) + " ms)");
+  }
+  const auto end_ns = static_cast<TimeNs>(std::llround(parts.duration_s * 1e9));
+  rt::TelemetrySample sample;
+  while (!loop.stopped()) {
+    if (clock.now() >= end_ns || interrupted(parts.options)) loop.request_stop();
+    for (std::uint64_t k = 0; k < ticks_per_host && !loop.stopped(); ++k) loop.step();
+    const HostStatus& host_status = parts.host.step(channels.state, channels.proxy);
+    parts.recorder.add_host_step(host_status);
+    while (channels.telemetry.try_pop(sample)) parts.recorder.add_tick(sample, host_status);
+    if (parts.view != nullptr) {
+      parts.view->rt_figures().publish(parts.rt_figures.update(parts.recorder));
+      parts.view->on_host_step(parts.host.simulation(), &parts.host.last_proxy());
+    }
+    out.session_time_s = to_seconds(clock.now());
+    parts.status.maybe_print(parts.recorder, out.session_time_s, parts.recorder.figures().ticks, parts.recorder.figures().host_steps);
+  }
+  loop.send_zero_command();
+  out.proxies_rejected = loop.data().proxy.rejected_count;
+  out.extra["sim_falcon"] = {{"exchanges", device.counters().exchanges},
+                             {"kinematics_failures", device.counters().kinematics_failures}};
+}
+
+/// Real time: the rt thread (SCHED_FIFO best effort) and the host thread (one step per host
+/// period); this thread drains telemetry, writes the trace and refreshes the status line.
+void run_realtime(SessionParts& parts, const falcon::SimFalconConfig& sim_config, RunFigures& out) {
+  const SessionOptions& options = parts.options;
+  const bool until_interrupted = parts.duration_s <= 0.0;
+  MonotonicClock clock;
+  std::unique_ptr<falcon::HapticDevice> device;
+  std::unique_ptr<UsbFalcon> usb;
+  if (options.device == SessionDevice::kUsb) {
+    usb = UsbFalcon::open(clock);
+  } else {
+    device = std::make_unique<falcon::SimFalcon>(sim_config, clock);
+  }
+  falcon::HapticDevice& haptic = usb ? usb->device() : *device;
+  out.device_name = haptic.name();
+  RtStack rt(parts.model, haptic, clock);
+  rt::RtLoop& loop = rt.loop();
+  RtChannels& channels = rt.channels();
+  auto host_statuses = std::make_unique<HostStatusRing>();
+  std::atomic<bool> stop_rt{false};
+  std::atomic<bool> stop_host{false};
+  std::atomic<std::uint64_t> dropped{0};
+  std::string host_error;
+  const TimeNs start_ns = clock.now();
+  const TimeNs end_ns = until_interrupted ? std::numeric_limits<TimeNs>::max()
+                                          : start_ns + static_cast<TimeNs>(std::llround(parts.duration_s * 1e9));
+
+  rt::RtThreadConfig thread_config;
+  thread_config.policy = rt::RtPolicy::kBestEffort;
+  RtThread rt_thread(thread_config, [&] {
+    // The session's length counts from the first tick, not from before the set-up.
+    loop.run_until(until_interrupted ? end_ns : clock.now() + (end_ns - start_ns), stop_rt);
+  });
+  HostLoop host_loop(clock);
+  std::thread host_thread([&] {
+    host_loop.run(static_cast<TimeNs>(std::llround(parts.host_dt_s() * 1e9)), stop_host, [&] {
+      try {
+        const HostStatus& st = parts.host.step(channels.state, channels.proxy);
+        if (!host_statuses->try_push(st)) dropped.fetch_add(1, std::memory_order_relaxed);
+        // Wait-free hand-off to the window / frame writer threads (never waits in real time).
+        if (parts.view != nullptr) parts.view->on_host_step(parts.host.simulation(), &parts.host.last_proxy());
+        return true;
+      } catch (const std::exception& e) {
+        host_error = e.what();
+        stop_rt.store(true);  // the proxy goes stale and fades; ramp out and stop
+        return false;
+      }
+    });
+  });
+
+  rt::TelemetrySample sample;
+  HostStatus host_status;
+  auto drain = [&] {
+    while (host_statuses->try_pop(host_status)) parts.recorder.add_host_step(host_status);
+    while (channels.telemetry.try_pop(sample)) parts.recorder.add_tick(sample, host_status);
+  };
+  while (!rt_thread.done()) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(kDrainPeriod_ms));
+    if (interrupted(options)) stop_rt.store(true);
+    drain();
+    if (parts.view != nullptr) parts.view->rt_figures().publish(parts.rt_figures.update(parts.recorder));
+    out.session_time_s = to_seconds(clock.now() - start_ns);
+    parts.status.maybe_print(parts.recorder, out.session_time_s, parts.recorder.figures().ticks, parts.recorder.figures().host_steps);
+  }
+  rt_thread.join();
+  stop_host.store(true);
+  host_thread.join();
+  drain();
+  if (!host_error.empty()) spdlog::error("host thread stopped: {}", host_error);
+  out.proxies_rejected = loop.data().proxy.rejected_count;
+  out.host_late_steps = host_loop.late_steps();
+  out.host_status_dropped = dropped.load();
+  out.wakeup_median_us = loop.stats().wakeup.quantile_us(0.5);
+  out.wakeup_p99_us = loop.stats().wakeup.quantile_us(0.99);
+  out.wakeup_max_us = loop.stats().wakeup.quantile_us(1.0);
+  out.max_tick_us = static_cast<double>(loop.stats().max_tick_ns) * 1e-3;
+  const rt::RtSetupReport& setup_report = rt_thread.setup_report();
+  out.extra["rt_setup"] = {{"sched_fifo", setup_report.sched_fifo},
+                           {"memory_locked", setup_report.memory_locked},
+                           {"seconds", rt_thread.setup_seconds()},
+                           {"warnings", std::string(setup_report.message)}};
+  if (setup_report.message[0] != '\0') spdlog::warn("rt thread: {}", setup_report.message);
+  if (!host_error.empty()) out.extra["host_error"] = host_error;
+}
+
+nlohmann::json view_json(const SessionOptions& options, const viewer::SessionViewStats& stats) {
+  nlohmann::json v;
+  v["window"] = {{"requested", options.view}, {"open", stats.window_open}, {"frames_drawn", stats.window_frames}};
+  if (!options.frames_dir.empty()) {
+    std::vector<double> frame_ms;
+    for (const double t : stats.frame_s) frame_ms.push_back(t * 1e3);
+    v["frames"] = {{"dir", options.frames_dir.string()},
+                   {"every_host_steps", options.frame_every},
+                   {"published", stats.frames_published},
+                   {"written", stats.frames_written},
+                   {"dropped", stats.frames_dropped},
+                   {"waited_for", options.lockstep},
+                   {"frame_ms", quantile_json(std::move(frame_ms))},
+                   {"gl", stats.gl_description},
+                   {"error", stats.frames_error}};
+  }
+  std::vector<double> publish_us;
+  for (const double t : stats.capture_publish_s) publish_us.push_back(t * 1e6);
+  v["capture_publish_us"] = quantile_json(std::move(publish_us));
+  return v;
+}
+
+nlohmann::json summary_json(const SessionParts& parts, const RunFigures& run, double wall_s,
+                            const std::optional<viewer::SessionViewStats>& view_stats) {
+  const SessionOptions& options = parts.options;
+  const SessionFigures& f = parts.recorder.figures();
+  nlohmann::json summary;
+  summary["scene"] = parts.scene.name;
+  summary["mode"] = options.lockstep ? "lockstep" : "realtime";
+  summary["device"] = run.device_name;
+  summary["duration_s"] = run.session_time_s;
+  summary["wall_s"] = wall_s;
+  summary["rt_rate_hz"] = options.rt_rate_hz;
+  summary["host_rate_hz"] = 1.0 / parts.host_dt_s();
+  summary["ticks"] = f.ticks;
+  // Over the ticks the loop ran (first to last telemetry sample), not the set-up before it.
+  const double ticking_s = to_seconds(f.last_tick_time_ns - f.first_tick_time_ns);
+  summary["tick_rate_hz"] = ticking_s > 0.0 ? static_cast<double>(f.telemetry_samples - 1) / ticking_s : 0.0;
+  summary["crossed_nodes_max"] = f.crossed_nodes_max;
+  summary["tool_reseats"] = f.tool_reseats;
+  summary["soft_volume_ratio_min"] = f.soft_volume_ratio_min;
+  summary["soft_everted"] = f.soft_volume_ratio_min < 0.0;
+  summary["faults"] = f.fault_ticks;
+  summary["fault_kinds"] = fault_names(f.fault_bits_seen);
+  summary["proxies_rejected"] = run.proxies_rejected;
+  summary["overruns"] = f.overruns;
+  summary["force_max_n"] = f.force_max_n;
+  summary["force_limit_n"] = parts.model.config.safety.max_force_n;
+  summary["contact_force_max_n"] = f.contact_force_max_n;
+  summary["host_force_max_n"] = f.host_force_max_n;
+  std::vector<double> ages = f.proxy_age_ms;
+  summary["proxy_age_ms"] = quantile_json(std::move(ages));
+  summary["energy_j"] = f.energy_j;
+  summary["energy_max_j"] = f.energy_max_j;
+  summary["passivity_controller"] = options.passivity_controller;
+  summary["contact_depth_max_mm"] = f.rt_penetration_max_m * 1e3;
+  summary["host_penetration_max_mm"] = f.host_penetration_max_m * 1e3;
+  summary["host_steps"] = f.host_steps;
+  summary["host_step_ms"] = quantile_json(f.host_step_ms);
+  summary["host_late_steps"] = run.host_late_steps;
+  summary["host_status_dropped"] = run.host_status_dropped;
+  if (!options.lockstep) {
+    summary["wakeup_latency_us"] = {{"median", run.wakeup_median_us}, {"p99", run.wakeup_p99_us}, {"max", run.wakeup_max_us}};
+    summary["max_tick_us"] = run.max_tick_us;
+    std::vector<double> intervals = f.tick_interval_us;
+    summary["tick_interval_us"] = quantile_json(std::move(intervals));
+  }
+  if (view_stats) {
+    summary["view"] = view_json(options, *view_stats);
+    if (!view_stats->frames_error.empty()) spdlog::error("--frames: {}", view_stats->frames_error);
+  }
+  summary["telemetry_samples"] = f.telemetry_samples;
+  for (const auto& [key, value] : run.extra.items()) summary[key] = value;
+  summary["machine"] = machine_info();
+  return summary;
+}
+
+SessionOutcome write_outcome(const SessionOptions& options, const host::SceneDescription& scene, const SessionRecorder& recorder,
+                             nlohmann::json summary) {
+  SessionOutcome outcome;
+  outcome.trace_path = recorder.trace_path();
+  outcome.summary_path = options.out_dir / "summary.json";
+  {
+    std::ofstream out(outcome.summary_path);
+    if (!out) throw SessionError("cannot write '" + outcome.summary_path.string() + "'");
+    out << summary.dump(2) << "\n";
+  }
+  if (options.plot) {
+    std::string error;
+    outcome.plot_path = plot_session(outcome.trace_path, options.out_dir / "session.png",
+                                     scene.name + (options.lockstep ? " (lockstep)" : " (real time)"), error);
+    if (outcome.plot_path.empty()) spdlog::warn("{}", error);
+  }
+  outcome.summary = std::move(summary);
+  return outcome;
+}
+
+}  // namespace
+
 SessionOutcome run_session(const SessionOptions& options) {
   const host::SceneDescription scene = scene_at_host_rate(options.scene, options.host_rate_hz);
   if (options.lockstep && options.device == SessionDevice::kUsb) {
@@ -177,266 +461,27 @@ SessionOutcome run_session(const SessionOptions& options) {
   host.settle(options.settle_s);
 
   const double expected_s = until_interrupted ? 60.0 : duration_s + 1.0;
-  // The view's picture model is built from the settled body (its rest shape is what the
-  // deformation colours are measured from), here, before any thread steps the simulation, and
-  // its sinks (window, frame writer) start before the first tick: Mesa maps and locks LLVM when
-  // it starts, which stalls a running rt loop for tens of ms (docs/decisions.md); started here,
-  // that cost lands in the rt set-up (summary.json's rt_setup.seconds), not in the session.
-  std::optional<viewer::RenderModel> view_model;
-  if (options.view || !options.frames_dir.empty()) {
-    try {
-      view_model = viewer::make_render_model(host.simulation());
-    } catch (const std::exception& e) {
-      throw SessionError(std::string("--view/--frames: ") + e.what());
-    }
-  }
-  std::unique_ptr<viewer::SessionView> view;
-  std::string view_error;
-  const auto start_view = [&] {
-    viewer::SessionViewOptions vo;
-    vo.window = options.view;
-    vo.window_options.width_px = options.frame_width_px;
-    vo.window_options.height_px = options.frame_height_px;
-    vo.window_options.method_switching = false;  // a session cannot swap its method under the hand
-    vo.window_options.screenshot_dir = options.out_dir;
-    vo.frames_dir = options.frames_dir;
-    vo.frame_every_steps = options.frame_every;
-    vo.frame_width_px = options.frame_width_px;
-    vo.frame_height_px = options.frame_height_px;
-    vo.wait_for_frames = options.lockstep;
-    vo.expected_host_steps = static_cast<std::size_t>(expected_s / host_dt_s);
-    std::string notice;
-    view = viewer::SessionView::start(*view_model, vo, view_error, notice);
-    if (!view) view_error = "--frames: " + view_error;
-    if (!notice.empty()) std::fprintf(stderr, "%s\n", notice.c_str());
-  };
-  if (view_model) {
-    start_view();
-    if (!view) throw SessionError(view_error);
-  }
-  RtFiguresTracker rt_figures;
+  std::unique_ptr<viewer::SessionView> view = start_view(options, host, expected_s, host_dt_s);
   SessionRecorder recorder(options.out_dir, static_cast<std::size_t>(expected_s * options.rt_rate_hz),
                            static_cast<std::size_t>(expected_s / host_dt_s));
   StatusPrinter status(options.status_line);
-  nlohmann::json extra;
+  SessionParts parts{options, scene, model, host, recorder, status, view.get()};
+  parts.duration_s = duration_s;
   const WallClock::time_point wall_start = WallClock::now();
-  double session_time_s = 0.0;
-  std::uint64_t proxies_rejected = 0;
-  std::uint64_t host_late_steps = 0;
-  std::uint64_t host_status_dropped = 0;
-  double wakeup_median_us = 0.0;
-  double wakeup_p99_us = 0.0;
-  double wakeup_max_us = 0.0;
-  double max_tick_us = 0.0;
-  std::string device_name;
-
   falcon::SimFalconConfig sim_config;
   sim_config.hand = scene.hand;
-
+  RunFigures run;
   if (options.lockstep) {
-    LockstepClock clock(0);
-    falcon::SimFalcon device(sim_config, clock);
-    device_name = device.name();
-    RtStack rt(model, device, clock);
-    rt::RtLoop& loop = rt.loop();
-    RtChannels& channels = rt.channels();
-    const double ratio = host_dt_s / model.period_s;
-    const auto ticks_per_host = static_cast<std::uint64_t>(std::llround(ratio));
-    if (ticks_per_host < 1 || std::abs(ratio - static_cast<double>(ticks_per_host)) > 1e-6 * ratio) {
-      throw SessionError("--lockstep: the host period (" + std::to_string(host_dt_s * 1e3) +
-                         " ms) must be a whole number of rt periods (" + std::to_string(model.period_s * 1e3) + " ms)");
-    }
-    const auto end_ns = static_cast<TimeNs>(std::llround(duration_s * 1e9));
-    rt::TelemetrySample sample;
-    while (!loop.stopped()) {
-      if (clock.now() >= end_ns || interrupted(options)) loop.request_stop();
-      for (std::uint64_t k = 0; k < ticks_per_host && !loop.stopped(); ++k) loop.step();
-      const HostStatus& host_status = host.step(channels.state, channels.proxy);
-      recorder.add_host_step(host_status);
-      while (channels.telemetry.try_pop(sample)) recorder.add_tick(sample, host_status);
-      if (view) {
-        view->rt_figures().publish(rt_figures.update(recorder));
-        view->on_host_step(host.simulation(), &host.last_proxy());
-      }
-      session_time_s = to_seconds(clock.now());
-      status.maybe_print(recorder, session_time_s, recorder.figures().ticks, recorder.figures().host_steps);
-    }
-    loop.send_zero_command();
-    proxies_rejected = loop.data().proxy.rejected_count;
-    extra["sim_falcon"] = {{"exchanges", device.counters().exchanges},
-                           {"kinematics_failures", device.counters().kinematics_failures}};
+    run_lockstep(parts, sim_config, run);
   } else {
-    MonotonicClock clock;
-    std::unique_ptr<falcon::HapticDevice> device;
-    std::unique_ptr<UsbFalcon> usb;
-    if (options.device == SessionDevice::kUsb) {
-      usb = UsbFalcon::open(clock);
-    } else {
-      device = std::make_unique<falcon::SimFalcon>(sim_config, clock);
-    }
-    falcon::HapticDevice& haptic = usb ? usb->device() : *device;
-    device_name = haptic.name();
-    RtStack rt(model, haptic, clock);
-    rt::RtLoop& loop = rt.loop();
-    RtChannels& channels = rt.channels();
-    auto host_statuses = std::make_unique<HostStatusRing>();
-    std::atomic<bool> stop_rt{false};
-    std::atomic<bool> stop_host{false};
-    std::atomic<std::uint64_t> dropped{0};
-    std::string host_error;
-    const TimeNs start_ns = clock.now();
-    const TimeNs end_ns = until_interrupted ? std::numeric_limits<TimeNs>::max()
-                                            : start_ns + static_cast<TimeNs>(std::llround(duration_s * 1e9));
-
-    rt::RtThreadConfig thread_config;
-    thread_config.policy = rt::RtPolicy::kBestEffort;
-    RtThread rt_thread(thread_config, [&] {
-      // The session's length counts from the first tick, not from before the set-up.
-      loop.run_until(until_interrupted ? end_ns : clock.now() + (end_ns - start_ns), stop_rt);
-    });
-    HostLoop host_loop(clock);
-    std::thread host_thread([&] {
-      host_loop.run(static_cast<TimeNs>(std::llround(host_dt_s * 1e9)), stop_host, [&] {
-        try {
-          const HostStatus& st = host.step(channels.state, channels.proxy);
-          if (!host_statuses->try_push(st)) dropped.fetch_add(1, std::memory_order_relaxed);
-          // Wait-free hand-off to the window / frame writer threads (never waits in real time).
-          if (view) view->on_host_step(host.simulation(), &host.last_proxy());
-          return true;
-        } catch (const std::exception& e) {
-          host_error = e.what();
-          stop_rt.store(true);  // the proxy goes stale and fades; ramp out and stop
-          return false;
-        }
-      });
-    });
-
-    rt::TelemetrySample sample;
-    HostStatus host_status;
-    auto drain = [&] {
-      while (host_statuses->try_pop(host_status)) recorder.add_host_step(host_status);
-      while (channels.telemetry.try_pop(sample)) recorder.add_tick(sample, host_status);
-    };
-    while (!rt_thread.done()) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(kDrainPeriod_ms));
-      if (interrupted(options)) stop_rt.store(true);
-      drain();
-      if (view) view->rt_figures().publish(rt_figures.update(recorder));
-      session_time_s = to_seconds(clock.now() - start_ns);
-      status.maybe_print(recorder, session_time_s, recorder.figures().ticks, recorder.figures().host_steps);
-    }
-    rt_thread.join();
-    stop_host.store(true);
-    host_thread.join();
-    drain();
-    if (!host_error.empty()) spdlog::error("host thread stopped: {}", host_error);
-    proxies_rejected = loop.data().proxy.rejected_count;
-    host_late_steps = host_loop.late_steps();
-    host_status_dropped = dropped.load();
-    wakeup_median_us = loop.stats().wakeup.quantile_us(0.5);
-    wakeup_p99_us = loop.stats().wakeup.quantile_us(0.99);
-    wakeup_max_us = loop.stats().wakeup.quantile_us(1.0);
-    max_tick_us = static_cast<double>(loop.stats().max_tick_ns) * 1e-3;
-    const rt::RtSetupReport& setup_report = rt_thread.setup_report();
-    extra["rt_setup"] = {{"sched_fifo", setup_report.sched_fifo},
-                         {"memory_locked", setup_report.memory_locked},
-                         {"seconds", rt_thread.setup_seconds()},
-                         {"warnings", std::string(setup_report.message)}};
-    if (setup_report.message[0] != '\0') spdlog::warn("rt thread: {}", setup_report.message);
-    if (!host_error.empty()) extra["host_error"] = host_error;
+    run_realtime(parts, sim_config, run);
   }
   status.finish();
   recorder.close_trace();
   std::optional<viewer::SessionViewStats> view_stats;
   if (view) view_stats = view->finish();
   const double wall_s = std::chrono::duration<double>(WallClock::now() - wall_start).count();
-
-  const SessionFigures& f = recorder.figures();
-  nlohmann::json summary;
-  summary["scene"] = scene.name;
-  summary["mode"] = options.lockstep ? "lockstep" : "realtime";
-  summary["device"] = device_name;
-  summary["duration_s"] = session_time_s;
-  summary["wall_s"] = wall_s;
-  summary["rt_rate_hz"] = options.rt_rate_hz;
-  summary["host_rate_hz"] = 1.0 / host_dt_s;
-  summary["ticks"] = f.ticks;
-  // Over the ticks the loop ran (first to last telemetry sample), not the set-up before it.
-  const double ticking_s = to_seconds(f.last_tick_time_ns - f.first_tick_time_ns);
-  summary["tick_rate_hz"] = ticking_s > 0.0 ? static_cast<double>(f.telemetry_samples - 1) / ticking_s : 0.0;
-  summary["crossed_nodes_max"] = f.crossed_nodes_max;
-  summary["tool_reseats"] = f.tool_reseats;
-  summary["soft_volume_ratio_min"] = f.soft_volume_ratio_min;
-  summary["soft_everted"] = f.soft_volume_ratio_min < 0.0;
-  summary["faults"] = f.fault_ticks;
-  summary["fault_kinds"] = fault_names(f.fault_bits_seen);
-  summary["proxies_rejected"] = proxies_rejected;
-  summary["overruns"] = f.overruns;
-  summary["force_max_n"] = f.force_max_n;
-  summary["force_limit_n"] = model.config.safety.max_force_n;
-  summary["contact_force_max_n"] = f.contact_force_max_n;
-  summary["host_force_max_n"] = f.host_force_max_n;
-  std::vector<double> ages = f.proxy_age_ms;
-  summary["proxy_age_ms"] = quantile_json(std::move(ages));
-  summary["energy_j"] = f.energy_j;
-  summary["energy_max_j"] = f.energy_max_j;
-  summary["passivity_controller"] = options.passivity_controller;
-  summary["contact_depth_max_mm"] = f.rt_penetration_max_m * 1e3;
-  summary["host_penetration_max_mm"] = f.host_penetration_max_m * 1e3;
-  summary["host_steps"] = f.host_steps;
-  summary["host_step_ms"] = quantile_json(f.host_step_ms);
-  summary["host_late_steps"] = host_late_steps;
-  summary["host_status_dropped"] = host_status_dropped;
-  if (!options.lockstep) {
-    summary["wakeup_latency_us"] = {{"median", wakeup_median_us}, {"p99", wakeup_p99_us}, {"max", wakeup_max_us}};
-    summary["max_tick_us"] = max_tick_us;
-    std::vector<double> intervals = f.tick_interval_us;
-    summary["tick_interval_us"] = quantile_json(std::move(intervals));
-  }
-  if (view_stats) {
-    nlohmann::json v;
-    v["window"] = {{"requested", options.view}, {"open", view_stats->window_open}, {"frames_drawn", view_stats->window_frames}};
-    if (!options.frames_dir.empty()) {
-      v["frames"] = {{"dir", options.frames_dir.string()},
-                     {"every_host_steps", options.frame_every},
-                     {"published", view_stats->frames_published},
-                     {"written", view_stats->frames_written},
-                     {"dropped", view_stats->frames_dropped},
-                     {"waited_for", options.lockstep},
-                     {"frame_ms", quantile_json([&] {
-                        std::vector<double> ms;
-                        for (const double t : view_stats->frame_s) ms.push_back(t * 1e3);
-                        return ms;
-                      }())},
-                     {"gl", view_stats->gl_description},
-                     {"error", view_stats->frames_error}};
-    }
-    std::vector<double> publish_us;
-    for (const double t : view_stats->capture_publish_s) publish_us.push_back(t * 1e6);
-    v["capture_publish_us"] = quantile_json(std::move(publish_us));
-    summary["view"] = v;
-    if (!view_stats->frames_error.empty()) spdlog::error("--frames: {}", view_stats->frames_error);
-  }
-  summary["telemetry_samples"] = f.telemetry_samples;
-  for (const auto& [key, value] : extra.items()) summary[key] = value;
-  summary["machine"] = machine_info();
-
-  SessionOutcome outcome;
-  outcome.trace_path = recorder.trace_path();
-  outcome.summary_path = options.out_dir / "summary.json";
-  {
-    std::ofstream out(outcome.summary_path);
-    if (!out) throw SessionError("cannot write '" + outcome.summary_path.string() + "'");
-    out << summary.dump(2) << "\n";
-  }
-  if (options.plot) {
-    std::string error;
-    outcome.plot_path = plot_session(outcome.trace_path, options.out_dir / "session.png",
-                                     scene.name + (options.lockstep ? " (lockstep)" : " (real time)"), error);
-    if (outcome.plot_path.empty()) spdlog::warn("{}", error);
-  }
-  outcome.summary = std::move(summary);
-  return outcome;
+  return write_outcome(options, scene, recorder, summary_json(parts, run, wall_s, view_stats));
 }
 
 }  // namespace fissure::session
