@@ -10,6 +10,7 @@
 
 #include "commands.hpp"
 #include "fissure/host_sim/scene_loader.hpp"
+#include "fissure/session/scene_plausibility.hpp"
 #include "fissure/session/host_end.hpp"
 #include "fissure/session/session_runner.hpp"
 #include "fissure/session/sigint_flag.hpp"
@@ -30,7 +31,7 @@ struct HostOptions {
 void run(const HostOptions& options) {
   host::SceneDescription loaded;
   try {
-    loaded = host::load_scene(host::resolve_scene_path(options.scene));
+    loaded = session::load_plausible_scene(options.scene);
   } catch (const std::exception& e) {
     throw CommandError(e.what());
   }

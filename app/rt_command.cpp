@@ -1,7 +1,7 @@
 // `fissure rt --transport can:IFACE|udp:HOST:PORT [--device sim|usb] [--scene SCENE] [--seconds N]`
 // The rt end of a split deployment on this machine (docs/deployment.md); the RT box runs the
 // same code as `fissure-rt`. Ctrl-C: the loop ramps the force out and the command exits 0; a
-// second Ctrl-C kills.
+// second Ctrl-C lets that finish, a third quits at once.
 #include "rt_command.hpp"
 
 #include <memory>

@@ -1,6 +1,8 @@
 // `fissure run SCENE [--lockstep] [--device sim|usb] [--duration S] [--out DIR] ...`
 // Ctrl-C (SIGINT) asks the rt loop to ramp the force out (rt_core/safety.hpp, 0.2 s), then the
-// session ends normally and still writes its trace, summary and plot. A second Ctrl-C kills.
+// session ends normally and still writes its trace, summary and plot; a second Ctrl-C lets that
+// finish, a third quits at once. Outputs reach their names only when complete
+// (session/output_staging.hpp).
 #include "run_command.hpp"
 
 #include <atomic>
@@ -12,7 +14,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include "commands.hpp"
 #include "fissure/host_sim/scene_loader.hpp"
+#include "fissure/session/scene_plausibility.hpp"
 #include "fissure/session/session_runner.hpp"
 
 #include "fissure/session/sigint_flag.hpp"
@@ -43,7 +47,7 @@ struct RunOptions {
 void run(const RunOptions& options) {
   host::SceneDescription scene;
   try {
-    scene = host::load_scene(host::resolve_scene_path(options.scene));
+    scene = load_plausible_scene(options.scene);
   } catch (const std::exception& e) {
     throw CommandError(e.what());
   }
@@ -113,8 +117,8 @@ void register_run(CommandTree& tree) {
   cmd->add_option("--device", options->device, "sim (SimFalcon with the scene's hand script) or usb (the real Falcon)")
       ->check(CLI::IsMember({"sim", "usb"}));
   cmd->add_flag("--lockstep", options->lockstep, "simulated time: deterministic, as fast as the CPU allows");
-  cmd->add_option("--duration", options->duration_s, "seconds (default: the hand script's length; usb: until Ctrl-C)")
-      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--duration", options->duration_s, "seconds, at most 86400 (default: the hand script's length; usb: until Ctrl-C)")
+      ->check(CLI::Validator([](std::string& text) { return check_seconds_at_most(text, 86400.0, "one day per session"); }, "0..86400"));
   cmd->add_option("--rate", options->rt_rate_hz, "rt tick rate [Hz] (500..10000)")->check(CLI::Range(500.0, 10000.0));
   cmd->add_option("--host-rate", options->host_rate_hz, "host step rate [Hz] (default: the scene's time step)")
       ->check(CLI::PositiveNumber);

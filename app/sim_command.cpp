@@ -21,7 +21,10 @@
 #include "fissure/host_sim/tool_mesh_io.hpp"
 #include "fissure/viewer/render_snapshot.hpp"
 #include "fissure/viewer/session_view.hpp"
+#include "fissure/config/table_reader.hpp"
 #include "fissure/eval/sim_report.hpp"
+#include "fissure/session/output_staging.hpp"
+#include "fissure/session/scene_plausibility.hpp"
 
 namespace fissure::app {
 using namespace fissure::eval;  // sim_quantile, SimProgress, sim_machine_info
@@ -80,18 +83,38 @@ std::optional<host::SceneCollisionMethod> parse_method(const std::string& name) 
   throw CLI::ValidationError("--method", "must be paired, ray or bullet (got '" + name + "')");
 }
 
+/// Step times kept for the timing quantiles: the first 2^20 steps (17 min at 1 kHz); a longer
+/// run's timing figures describe its first 2^20 steps.
+constexpr std::size_t kExactSteps = std::size_t{1} << 20;
+/// The longest run `fissure sim` accepts [s]: a day of simulated time.
+constexpr double kMaxSimSeconds = 86400.0;
+
 /// What a headless run accumulates over its steps.
 struct SimFigures {
   std::vector<double> step_s, collision_s, force_in_contact;
   int crossed_max = 0, contacts_max = 0, wrong_side_max = 0, inside_max = 0;
   double penetration_max = 0.0, force_max = 0.0;
   bool finite = true;
+  /// The first non-finite quantity, with its step time ("" while all are finite).
+  std::string first_non_finite;
 
-  void add(const host::HostStepResult& r) {
-    step_s.push_back(r.times.total_s);
-    collision_s.push_back(r.times.collision_s);
+  void add(const host::HostStepResult& r, const Eigen::Vector3d& tool_position_world_m) {
+    if (step_s.size() < kExactSteps) {
+      step_s.push_back(r.times.total_s);
+      collision_s.push_back(r.times.collision_s);
+    }
     const double f = r.force_on_tool_world_n.norm();
-    finite = finite && std::isfinite(f);
+    const char* bad = !std::isfinite(f)                                   ? "force on the tool (force_*_n)"
+                      : !tool_position_world_m.allFinite()                 ? "tool position (tool_*_m)"
+                      : !std::isfinite(r.crossing.max_penetration_m)       ? "penetration depth (max_penetration_m)"
+                      : !std::isfinite(r.part_force_world_n[0].norm())     ? "jaw force (jaw_a_force_n)"
+                                                                           : nullptr;
+    if (bad != nullptr && first_non_finite.empty()) {
+      char text[160];
+      std::snprintf(text, sizeof text, "%s at t = %.4f s", bad, r.time_s);
+      first_non_finite = text;
+    }
+    finite = finite && bad == nullptr;
     force_max = std::max(force_max, f);
     if (r.contact_count > 0) force_in_contact.push_back(f);
     crossed_max = std::max(crossed_max, r.crossing.crossed_nodes);
@@ -113,11 +136,11 @@ struct SimFigures {
   }
 };
 
-std::ofstream open_csv_trace(const std::string& path) {
+std::ofstream open_csv_trace(const std::filesystem::path& path) {
   std::ofstream csv;
   if (path.empty()) return csv;
   csv.open(path);
-  if (!csv) throw CommandError("cannot write the CSV trace '" + path + "'");
+  if (!csv) throw CommandError("cannot write the CSV trace '" + path.string() + "'");
   csv << "time_s,tool_x_m,tool_y_m,tool_z_m,jaw_gap_m,force_x_n,force_y_n,force_z_n,jaw_a_force_n,jaw_b_force_n,contacts,"
          "crossed_nodes,max_penetration_m,step_us,collision_us\n";
   csv.precision(9);
@@ -134,15 +157,16 @@ void write_csv_row(std::ofstream& csv, const host::HostSimulation& sim, const ho
 
 // --frames: PNGs of every frame_every-th step, drawn by viewer/'s writer thread from the
 // settled body's picture model. Offline, so each frame is waited for (none dropped).
-std::unique_ptr<viewer::SessionView> start_frames(const SimOptions& options, host::HostSimulation& sim, long steps) {
+std::unique_ptr<viewer::SessionView> start_frames(const SimOptions& options, host::HostSimulation& sim, long steps,
+                                                  const std::filesystem::path& staged_frames_dir) {
   if (options.frames_dir.empty()) return nullptr;
   viewer::SessionViewOptions vo;
-  vo.frames_dir = options.frames_dir;
+  vo.frames_dir = staged_frames_dir;
   vo.frame_every_steps = options.frame_every;
   vo.frame_width_px = options.width_px;
   vo.frame_height_px = options.height_px;
   vo.wait_for_frames = true;
-  vo.expected_host_steps = static_cast<std::size_t>(steps);
+  vo.expected_host_steps = std::min(static_cast<std::size_t>(steps), kExactSteps);
   std::string error, notice;
   std::unique_ptr<viewer::SessionView> view;
   try {
@@ -163,8 +187,8 @@ void print_summary(const SimFigures& f) {
               sim_quantile(f.step_s, 0.99) * 1e6, sim_quantile(f.collision_s, 0.5) * 1e6, sim_quantile(f.collision_s, 0.99) * 1e6);
 }
 
-void write_json(const SimOptions& options, const host::SceneDescription& scene, const host::HostSimulation& sim, long steps,
-                const SimFigures& f, const std::optional<viewer::SessionViewStats>& frames) {
+void write_json(const SimOptions& options, const std::filesystem::path& path, const host::SceneDescription& scene,
+                const host::HostSimulation& sim, long steps, const SimFigures& f, const std::optional<viewer::SessionViewStats>& frames) {
   nlohmann::json j;
   j["scene"] = scene.name;
   j["scene_file"] = scene.source_path;
@@ -188,15 +212,15 @@ void write_json(const SimOptions& options, const host::SceneDescription& scene, 
                    {"dropped", frames->frames_dropped}, {"frame_ms_median", sim_quantile(frames->frame_s, 0.5) * 1e3}};
   }
   j["machine"] = sim_machine_info();
-  std::ofstream out(options.json_path);
-  if (!out) throw CommandError("cannot write the JSON summary '" + options.json_path + "'");
+  std::ofstream out(path);
   out << j.dump(2) << '\n';
+  if (!out) throw CommandError("cannot write the JSON summary '" + options.json_path + "'");
 }
 
 std::unique_ptr<host::HostSimulation> open_simulation(const SimOptions& options, host::SceneDescription& scene) {
   const auto method = parse_method(options.method);
   try {
-    scene = host::load_scene(host::resolve_scene_path(options.scene));
+    scene = session::load_plausible_scene(options.scene);
   } catch (const host::SceneError& e) {
     throw CommandError(e.what());
   }
@@ -215,28 +239,42 @@ void run_sim(const SimOptions& options) {
   if (options.scene.empty()) throw CLI::ValidationError("SCENE", "a scene name or file is required");
   host::SceneDescription scene;
   const std::unique_ptr<host::HostSimulation> sim = open_simulation(options, scene);
-  std::ofstream csv = open_csv_trace(options.csv_path);
+  const double duration_s = options.seconds > 0.0 ? options.seconds : host::trajectory_duration_s(scene);
+  if (duration_s > kMaxSimSeconds) {
+    throw CommandError(scene.source_path + ": the trajectory lasts " + config::format_number(duration_s) +
+                       " s (its legs and hold_s); at most " + config::format_number(kMaxSimSeconds) + " s (one day)");
+  }
   const Eigen::AlignedBox3d before = sim->soft_bounds_world_m();
   sim->settle(options.settle_seconds);
+  try {
+    session::require_settled_on_ground(*sim, scene, options.settle_seconds);
+  } catch (const std::exception& e) {
+    throw CommandError(scene.source_path + ": " + e.what());
+  }
   const Eigen::AlignedBox3d settled = sim->soft_bounds_world_m();
   std::printf("soft body bounds y: %.4f .. %.4f m at load, %.4f .. %.4f m after settling %.2f s\n", before.min().y(), before.max().y(),
               settled.min().y(), settled.max().y(), options.settle_seconds);
-  const double duration_s = options.seconds > 0.0 ? options.seconds : host::trajectory_duration_s(scene);
   const double dt = scene.simulation.time_step_s;
   const long steps = std::max(1L, std::lround(duration_s / dt));
-  std::unique_ptr<viewer::SessionView> view = start_frames(options, *sim, steps);
+  // Outputs reach their names only when the run is complete and valid (session/output_staging.hpp).
+  session::OutputStaging staging;
+  std::ofstream csv = open_csv_trace(options.csv_path.empty() ? std::filesystem::path() : staging.file(options.csv_path));
+  const std::filesystem::path staged_frames =
+      options.frames_dir.empty() ? std::filesystem::path() : staging.directory(options.frames_dir, "frame_", ".png");
+  std::unique_ptr<viewer::SessionView> view = start_frames(options, *sim, steps, staged_frames);
   std::printf("scene %s: %s, method %s, %d faces / %d nodes, %ld steps of %.3g ms\n", scene.name.c_str(), scene.description.c_str(),
               host::to_string(sim->method()), sim->soft_face_count(), sim->soft_node_count(), steps, dt * 1e3);
   SimProgress progress("sim " + scene.name, steps);
   SimFigures figures;
-  figures.step_s.reserve(static_cast<std::size_t>(steps));
-  figures.collision_s.reserve(static_cast<std::size_t>(steps));
+  figures.step_s.reserve(std::min(static_cast<std::size_t>(steps), kExactSteps));
+  figures.collision_s.reserve(std::min(static_cast<std::size_t>(steps), kExactSteps));
   for (long i = 0; i < steps; ++i) {
     const host::TrajectorySample target = sim->scripted_target();
     const host::HostStepResult& r = sim->step(host::to_tool_pose(target.pose), target.jaw_gap_m);
     if (view) view->on_host_step(*sim, nullptr);
-    figures.add(r);
+    figures.add(r, sim->tool_pose().position_world_m);
     if (csv.is_open()) write_csv_row(csv, *sim, r);
+    if (!figures.first_non_finite.empty()) break;  // nothing after it is meaningful
     if (i % 50 == 0 || i + 1 == steps) {
       char status[160];
       std::snprintf(status, sizeof status, "t %.3f s |F| %.3f N contacts %d crossed %d", r.time_s, r.force_on_tool_world_n.norm(),
@@ -253,8 +291,17 @@ void run_sim(const SimOptions& options) {
                 static_cast<unsigned long long>(frames->frames_written), options.frames_dir.c_str(), options.frame_every,
                 sim_quantile(frames->frame_s, 0.5) * 1e3, frames->gl_description.c_str());
   }
+  if (!figures.first_non_finite.empty()) {
+    throw CommandError(scene.source_path + ": the simulation produced a non-finite " + figures.first_non_finite +
+                       "; nothing was written (see docs/scenes.md, \"Plausible values\")");
+  }
   print_summary(figures);
-  if (!options.json_path.empty()) write_json(options, scene, *sim, steps, figures, frames);
+  if (csv.is_open()) {
+    csv.close();
+    if (!csv) throw CommandError("cannot write the CSV trace '" + options.csv_path + "'");
+  }
+  if (!options.json_path.empty()) write_json(options, staging.file(options.json_path), scene, *sim, steps, figures, frames);
+  staging.commit();
 }
 
 }  // namespace
@@ -264,7 +311,8 @@ void register_sim(CommandTree& tree) {
   CLI::App* sim = tree.root.add_subcommand("sim", "Run a scene's host simulation headless on its scripted tool trajectory");
   sim->add_option("scene", options->scene, "Scene name (scenes/NAME.toml) or path to a scene file");
   sim->add_option("--method", options->method, "Collision method: paired | ray | bullet (default: the scene's)");
-  sim->add_option("--seconds", options->seconds, "Simulated seconds (default: the trajectory's duration)")->check(CLI::PositiveNumber);
+  sim->add_option("--seconds", options->seconds, "Simulated seconds, at most 86400 (default: the trajectory's duration)")
+      ->check(CLI::PositiveNumber & CLI::Validator([](std::string& text) { return check_seconds_at_most(text, kMaxSimSeconds, "one day of simulated time"); }, "0..86400"));
   sim->add_option("--settle-seconds", options->settle_seconds, "Let the soft body settle under gravity first [s]")->check(CLI::NonNegativeNumber);
   sim->add_option("--json", options->json_path, "Write the summary JSON here");
   sim->add_option("--csv", options->csv_path, "Write the per-step trace CSV here");

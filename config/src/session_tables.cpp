@@ -1,5 +1,6 @@
 #include "fissure/config/session_tables.hpp"
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -7,6 +8,9 @@
 
 namespace fissure::config {
 namespace {
+
+/// Longest hand hold [s]: a day at the bench (a session is at most that long).
+constexpr double kMaxHold_s = 86400.0;
 
 std::array<std::uint8_t, 3> read_permutation(TableReader& t) {
   const toml::node& node = t.require("axis_permutation", "");
@@ -63,7 +67,7 @@ void read_hand(const std::string& file, TableReader& t, HandScript& hand) {
       HandWaypoint wp;
       wp.position_device_m = w.vec3("position_device", "m");
       wp.speed_m_per_s = w.positive("speed", "m_per_s");
-      wp.hold_s = w.in_range("hold", "s", 0.0, 1e6, 0.0);
+      wp.hold_s = w.in_range("hold", "s", 0.0, kMaxHold_s, 0.0);
       w.finish();
       hand.waypoints.push_back(wp);
     }
@@ -101,21 +105,46 @@ RtSessionConfig load_rt_session_config(const std::filesystem::path& file) {
   return load_rt_session_config_text(read_config_file(file), file.string());
 }
 
-std::filesystem::path find_scenes_dir() {
+namespace {
+
+/// Where scene names are looked up, in order: $FISSURE_SCENES_DIR, ./scenes, then scenes/ in
+/// every directory above the executable (build-*/bin/fissure: the source tree's scenes/).
+std::vector<std::filesystem::path> scene_dir_candidates() {
   namespace fs = std::filesystem;
   std::vector<fs::path> candidates;
   if (const char* env = std::getenv("FISSURE_SCENES_DIR")) candidates.emplace_back(env);
-  candidates.emplace_back(fs::current_path() / "scenes");
   std::error_code ec;
+  candidates.push_back(fs::current_path(ec) / "scenes");
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   if (!ec) {
-    // build-*/bin/fissure or build-*/tests/x_test: the source tree is two levels up.
     for (fs::path dir = exe.parent_path(); !dir.empty() && dir != dir.root_path(); dir = dir.parent_path()) {
       candidates.push_back(dir / "scenes");
     }
   }
+  std::vector<fs::path> unique;
   for (const fs::path& c : candidates) {
-    if (fs::is_directory(c, ec)) return c;
+    if (std::find(unique.begin(), unique.end(), c.lexically_normal()) == unique.end()) unique.push_back(c.lexically_normal());
+  }
+  return unique;
+}
+
+/// The scene names (file stems) in `dir`, sorted.
+std::vector<std::string> scene_names_in(const std::filesystem::path& dir) {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    if (entry.path().extension() == ".toml" && entry.is_regular_file(ec)) names.push_back(entry.path().stem().string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+}  // namespace
+
+std::filesystem::path find_scenes_dir() {
+  std::error_code ec;
+  for (const std::filesystem::path& c : scene_dir_candidates()) {
+    if (std::filesystem::is_directory(c, ec)) return c;
   }
   return {};
 }
@@ -125,14 +154,24 @@ std::filesystem::path resolve_scene_path(std::string_view name_or_path) {
   const fs::path given{std::string(name_or_path)};
   std::error_code ec;
   if (fs::is_regular_file(given, ec)) return given;
-  const fs::path dir = find_scenes_dir();
-  if (!dir.empty()) {
+  if (fs::is_directory(given, ec)) {
+    throw SceneError(given.string(), 0, "", "is a directory, not a scene file (a scene is one .toml file, e.g. scenes/spatula-sphere.toml)");
+  }
+  std::string looked;
+  std::vector<std::string> known;
+  for (const fs::path& dir : scene_dir_candidates()) {
     fs::path candidate = dir / given;
     if (candidate.extension() != ".toml") candidate += ".toml";
     if (fs::is_regular_file(candidate, ec)) return candidate;
+    const bool is_dir = fs::is_directory(dir, ec);
+    looked += (looked.empty() ? "" : ", ") + candidate.string() + (is_dir ? "" : " (no such directory)");
+    if (is_dir && known.empty()) known = scene_names_in(dir);
   }
+  std::string names;
+  for (const std::string& n : known) names += (names.empty() ? "" : ", ") + n;
   throw SceneError(std::string(name_or_path), 0, "",
-                   "no such scene file or scene name (looked in " + (dir.empty() ? std::string("no scenes/ directory found") : dir.string()) + ")");
+                   "no such scene file or scene name; looked for " + looked +
+                       (names.empty() ? std::string("; no scenes found") : "; known scenes: " + names));
 }
 
 }  // namespace fissure::config

@@ -1,5 +1,8 @@
 #include "fissure/config/table_reader.hpp"
 
+#include <algorithm>
+#include <cstdio>
+#include <vector>
 #include <fstream>
 
 namespace fissure::config {
@@ -8,7 +11,9 @@ namespace {
 
 std::string format_error(const std::string& file, int line, const std::string& field, const std::string& message) {
   std::ostringstream out;
-  out << file << ':' << line << ": ";
+  out << file;
+  if (line > 0) out << ':' << line;  // line 0: the file as a whole (unreadable, not found)
+  out << ": ";
   if (!field.empty()) out << "field '" << field << "': ";
   out << message;
   return out.str();
@@ -17,6 +22,55 @@ std::string format_error(const std::string& file, int line, const std::string& f
 }  // namespace
 
 int line_of(const toml::node& node) { return static_cast<int>(node.source().begin.line); }
+
+int line_of_field(const std::filesystem::path& file, std::string_view dotted_path) noexcept {
+  try {
+    const toml::table root = toml::parse_file(file.string());
+    const toml::node_view<const toml::node> node = root.at_path(dotted_path);
+    return node ? line_of(*node.node()) : 0;
+  } catch (...) {
+    return 0;  // only a line number for a message is lost
+  }
+}
+
+namespace {
+
+/// Levenshtein distance (insert, delete, substitute) between two short keys.
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+/// Edits that still read as a typo of the key rather than another key.
+constexpr std::size_t kTypoEdits = 2;
+
+}  // namespace
+
+std::string misspelling_hint(const toml::table& table, const std::string& expected) {
+  for (const auto& [key, node] : table) {
+    const std::string k(key.str());
+    if (k != expected && edit_distance(k, expected) <= kTypoEdits) {
+      return "; is '" + k + "' (line " + std::to_string(line_of(node)) + ") a misspelling of it?";
+    }
+  }
+  return {};
+}
+
+std::string format_number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.4g", value);
+  return text;
+}
 
 // Unit suffixes we recognise at the end of a key, longest first so "_m_per_s2" wins over
 // "_m". Used only to tell "wrong unit" from "unknown key".

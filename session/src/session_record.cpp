@@ -15,14 +15,47 @@ namespace {
 
 double norm(const Vec3& v) { return as_eigen(v).norm(); }
 
+bool finite(const Vec3& v) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
+
+/// The first non-finite quantity of a telemetry sample, by the trace column's name; null when all are finite.
+const char* non_finite_quantity(const rt::TelemetrySample& s) {
+  if (!finite(s.tool_position_world_m)) return "tool position (tool_*_world_m)";
+  if (!std::isfinite(s.jaw_closing_m)) return "jaw closing (jaw_closing_m)";
+  if (!finite(s.force_device_n)) return "commanded device force (force_*_device_n)";
+  if (!finite(s.contact_force_device_n)) return "contact force (contact_force_n)";
+  if (!std::isfinite(s.max_penetration_m)) return "rt penetration depth (penetration_m)";
+  if (!std::isfinite(s.energy_j)) return "passivity energy (energy_j)";
+  if (!std::isfinite(s.fade_gain) || !std::isfinite(s.ramp_gain)) return "force gains (fade_gain, ramp_gain)";
+  return nullptr;
+}
+
+const char* non_finite_quantity(const HostStatus& h) {
+  if (!std::isfinite(h.force_n)) return "host contact force (host_force_n)";
+  if (!std::isfinite(h.max_penetration_m)) return "host penetration depth (host_penetration_m)";
+  if (!std::isfinite(h.soft_volume_ratio)) return "soft body volume (soft_volume_ratio)";
+  return nullptr;
+}
+
 }  // namespace
 
-SessionRecorder::SessionRecorder(const std::filesystem::path& out_dir, std::size_t expected_ticks,
-                                 std::size_t expected_host_steps)
-    : out_dir_(out_dir), trace_path_(out_dir / "trace.csv") {
-  std::error_code ec;
-  std::filesystem::create_directories(out_dir_, ec);
-  if (ec) throw SessionError("cannot create output directory '" + out_dir_.string() + "': " + ec.message());
+void SampleReservoir::add(double value) {
+  max_ = count_ == 0 ? value : std::max(max_, value);
+  ++count_;
+  if (values_.size() < kCapacity) {
+    values_.push_back(value);
+    return;
+  }
+  // splitmix64: a fixed, portable sequence (std::uniform_int_distribution is not portable).
+  rng_state_ += 0x9E3779B97F4A7C15ull;
+  std::uint64_t z = rng_state_;
+  z = (z ^ (z >> 30u)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27u)) * 0x94D049BB133111EBull;
+  z ^= z >> 31u;
+  const std::uint64_t slot = z % count_;
+  if (slot < kCapacity) values_[slot] = value;
+}
+
+SessionRecorder::SessionRecorder(const std::filesystem::path& trace_path) : trace_path_(trace_path) {
   trace_ = std::fopen(trace_path_.c_str(), "w");
   if (trace_ == nullptr) throw SessionError("cannot write '" + trace_path_.string() + "'");
   std::fprintf(trace_,
@@ -30,9 +63,13 @@ SessionRecorder::SessionRecorder(const std::filesystem::path& out_dir, std::size
                "force_x_device_n,force_y_device_n,force_z_device_n,force_n,contact_force_n,"
                "penetration_m,patches_in_contact,proxy_age_ms,proxy_sequence,energy_j,fade_gain,ramp_gain,"
                "fault_bits,overruns,host_time_s,host_force_n,host_contacts,host_crossed_nodes,host_penetration_m\n");
-  figures_.proxy_age_ms.reserve(expected_ticks);
-  figures_.host_step_ms.reserve(expected_host_steps);
-  figures_.tick_interval_us.reserve(expected_ticks);
+}
+
+void SessionRecorder::note_non_finite(const char* quantity, double time_s, std::uint64_t tick) {
+  if (!figures_.first_non_finite.empty()) return;
+  char text[192];
+  std::snprintf(text, sizeof text, "%s (tick %llu, t = %.4f s)", quantity, static_cast<unsigned long long>(tick), time_s);
+  figures_.first_non_finite = text;
 }
 
 SessionRecorder::~SessionRecorder() { close_trace(); }
@@ -50,11 +87,12 @@ void SessionRecorder::add_host_step(const HostStatus& host) {
   figures_.soft_volume_ratio_min = std::min(figures_.soft_volume_ratio_min, host.soft_volume_ratio);
   figures_.host_penetration_max_m = std::max(figures_.host_penetration_max_m, host.max_penetration_m);
   figures_.host_force_max_n = std::max(figures_.host_force_max_n, host.force_n);
-  figures_.host_step_ms.push_back(host.step_cpu_s * 1e3);
+  figures_.host_step_ms.add(host.step_cpu_s * 1e3);
+  if (const char* quantity = non_finite_quantity(host)) note_non_finite(quantity, static_cast<double>(host.host_time_ns) * 1e-9, last_.tick);
 }
 
 void SessionRecorder::add_tick(const rt::TelemetrySample& s, const HostStatus& host) {
-  if (figures_.telemetry_samples > 0) figures_.tick_interval_us.push_back(static_cast<double>(s.time_ns - last_.time_ns) * 1e-3);
+  if (figures_.telemetry_samples > 0) figures_.tick_interval_us.add(static_cast<double>(s.time_ns - last_.time_ns) * 1e-3);
   last_ = s;
   if (figures_.telemetry_samples++ == 0) figures_.first_tick_time_ns = s.time_ns;
   figures_.last_tick_time_ns = s.time_ns;
@@ -71,7 +109,10 @@ void SessionRecorder::add_tick(const rt::TelemetrySample& s, const HostStatus& h
   figures_.energy_j = s.energy_j;
   figures_.energy_max_j = std::max(figures_.energy_max_j, s.energy_j);
   const double age_ms = static_cast<double>(s.proxy_age_ns) * 1e-6;
-  if (s.proxy_sequence != 0) figures_.proxy_age_ms.push_back(age_ms);
+  if (s.proxy_sequence != 0) figures_.proxy_age_ms.add(age_ms);
+  if (const char* quantity = non_finite_quantity(s)) {
+    note_non_finite(quantity, static_cast<double>(s.time_ns - figures_.first_tick_time_ns) * 1e-9, s.tick);
+  }
   if (trace_ != nullptr) {
     std::fprintf(trace_,
                  "%.6f,%llu,%.7g,%.7g,%.7g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%u,%.4f,%llu,%.6g,%.4g,%.4g,%u,%llu,%.6f,%.6g,%d,%d,%.6g\n",
@@ -106,6 +147,13 @@ Quantiles quantiles(std::vector<double>& values) {
   q.median = rank(0.5);
   q.p99 = rank(0.99);
   q.max = values.back();
+  return q;
+}
+
+Quantiles quantiles(const SampleReservoir& samples) {
+  std::vector<double> values = samples.values();
+  Quantiles q = quantiles(values);
+  q.max = samples.max();
   return q;
 }
 

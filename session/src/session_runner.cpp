@@ -27,6 +27,8 @@
 #include "fissure/viewer/render_snapshot.hpp"
 #include "fissure/viewer/session_view.hpp"
 #include "fissure/session/host_loop.hpp"
+#include "fissure/session/output_staging.hpp"
+#include "fissure/session/scene_plausibility.hpp"
 #include "fissure/session/rt_stack.hpp"
 #include "fissure/session/session_host.hpp"
 
@@ -40,6 +42,8 @@ constexpr double kStatusPeriod_s = 0.1;
 /// How often the main thread drains telemetry in real time [ms]: the 8192-sample ring holds
 /// 8 s at 1 kHz, so 10 ms is far inside it and keeps Ctrl-C responsive.
 constexpr int kDrainPeriod_ms = 10;
+/// Session time the view's per-step figures are reserved for up front [s]; longer sessions grow them.
+constexpr double kReservedView_s = 600.0;
 /// Host statuses buffered between drains: 4096 host steps ≥ 4 s at 1 kHz.
 constexpr std::size_t kHostStatusCapacity = 4096;
 
@@ -49,6 +53,93 @@ using HostStatusRing = SpscRing<HostStatus, kHostStatusCapacity>;
 nlohmann::json quantile_json(std::vector<double> values) {
   const Quantiles q = quantiles(values);
   return {{"median", q.median}, {"p99", q.p99}, {"max", q.max}};
+}
+
+nlohmann::json quantile_json(const SampleReservoir& samples) {
+  const Quantiles q = quantiles(samples);
+  nlohmann::json j = {{"median", q.median}, {"p99", q.p99}, {"max", q.max}};
+  // Beyond the reservoir the median and p99 come from a uniform sample of the values; say of how many.
+  if (!samples.exact()) j["sampled_from"] = samples.count();
+  return j;
+}
+
+/// The dotted path of the first non-finite number in `j` ("" when there is none): JSON has no
+/// NaN or infinity, nlohmann writes them as null, and a summary with a null figure is not valid.
+std::string first_non_finite_key(const nlohmann::json& j, const std::string& path) {
+  if (j.is_number_float()) return std::isfinite(j.get<double>()) ? std::string() : path;
+  if (j.is_object()) {
+    for (const auto& [key, value] : j.items()) {
+      const std::string found = first_non_finite_key(value, path.empty() ? key : path + "." + key);
+      if (!found.empty()) return found;
+    }
+  }
+  if (j.is_array()) {
+    for (std::size_t i = 0; i < j.size(); ++i) {
+      const std::string found = first_non_finite_key(j[i], path + "[" + std::to_string(i) + "]");
+      if (!found.empty()) return found;
+    }
+  }
+  return {};
+}
+
+/// Whole seconds the longest session may last: a day at the bench. Longer is a typo (1e9) and
+/// in lockstep would never end.
+constexpr double kMaxSessionDuration_s = 86400.0;
+/// The lockstep rt rates the command line accepts (--rate's range) [Hz].
+constexpr double kMinRtRate_hz = 500.0;
+constexpr double kMaxRtRate_hz = 10000.0;
+/// How many whole-divisor --rate values a refusal suggests.
+constexpr int kRateSuggestions = 4;
+
+std::string ms_text(double seconds) {
+  char text[48];
+  std::snprintf(text, sizeof text, "%.4g ms", seconds * 1e3);
+  return text;
+}
+
+std::string hz_text(double hz) {
+  char text[48];
+  std::snprintf(text, sizeof text, "%.6g", hz);
+  return text;
+}
+
+/// Lockstep runs N whole rt ticks per host step: refuses, before anything is built, a host step
+/// that is no whole number of rt periods, and says which --rate or --host-rate would work.
+void check_lockstep_rates(const SessionOptions& options, const host::SceneDescription& scene) {
+  if (!options.lockstep) return;
+  const double host_dt_s = scene.simulation.time_step_s;
+  const double rt_period_s = 1.0 / options.rt_rate_hz;
+  const double ratio = host_dt_s / rt_period_s;
+  const long ticks = std::lround(ratio);
+  if (ticks >= 1 && std::abs(ratio - static_cast<double>(ticks)) <= 1e-6 * ratio) return;
+  const std::string host_source = options.host_rate_hz > 0.0 ? "--host-rate" : "the scene's simulation.time_step_s";
+  std::string message = "--lockstep: the host step (" + ms_text(host_dt_s) + ", " + host_source +
+                        ") must be a whole number of rt periods (" + ms_text(rt_period_s) + " at --rate " + hz_text(options.rt_rate_hz) +
+                        " Hz)";
+  std::string rates;
+  int suggested = 0;
+  for (long n = std::max(1L, static_cast<long>(std::ceil(kMinRtRate_hz * host_dt_s - 1e-9)));
+       suggested < kRateSuggestions && static_cast<double>(n) / host_dt_s <= kMaxRtRate_hz * (1.0 + 1e-9); ++n, ++suggested) {
+    rates += (rates.empty() ? "" : ", ") + hz_text(static_cast<double>(n) / host_dt_s);
+  }
+  if (!rates.empty()) {
+    message += ": use --rate " + rates;
+  } else {
+    message += ": the host step is " + std::string(ratio < 1.0 ? "shorter than one rt period" : "too long") +
+               " for any --rate in 500..10000 Hz; use --host-rate H with a whole number of rt periods per host step (e.g. --host-rate " +
+               hz_text(options.rt_rate_hz) + ")";
+  }
+  throw SessionError(message, true);
+}
+
+/// Session lengths that can run: a day at most, from --duration or the scene's hand script.
+void check_duration(const SessionOptions& options, const host::SceneDescription& scene, double duration_s) {
+  if (duration_s <= kMaxSessionDuration_s) return;
+  const std::string source =
+      options.duration_s > 0.0 ? "--duration" : "the hand script of " + scene.source_path + " (its legs and hold_s)";
+  throw SessionError(source + " makes the session " + hz_text(duration_s) + " s long; at most " + hz_text(kMaxSessionDuration_s) +
+                         " s (one day) per session",
+                     options.duration_s > 0.0);
 }
 
 nlohmann::json fault_names(std::uint32_t bits) {
@@ -167,6 +258,7 @@ struct SessionParts {
   SessionRecorder& recorder;
   StatusPrinter& status;
   viewer::SessionView* view;        ///< null without --view/--frames
+  UsbFalcon* usb;                   ///< the opened USB Falcon (--device usb), else null
   RtFiguresTracker rt_figures{};
   double duration_s = 0.0;          ///< 0: until interrupted
   [[nodiscard]] double host_dt_s() const { return scene.simulation.time_step_s; }
@@ -192,7 +284,7 @@ struct RunFigures {
 // starts, which stalls a running rt loop for tens of ms (docs/decisions.md); started here,
 // that cost lands in the rt set-up (summary.json's rt_setup.seconds), not in the session.
 std::unique_ptr<viewer::SessionView> start_view(const SessionOptions& options, SessionHost& host, double expected_s,
-                                                double host_dt_s) {
+                                                double host_dt_s, const std::filesystem::path& staged_frames_dir) {
   if (!options.view && options.frames_dir.empty()) return nullptr;
   viewer::RenderModel view_model;
   try {
@@ -206,12 +298,12 @@ std::unique_ptr<viewer::SessionView> start_view(const SessionOptions& options, S
   vo.window_options.height_px = options.frame_height_px;
   vo.window_options.method_switching = false;  // a session cannot swap its method under the hand
   vo.window_options.screenshot_dir = options.out_dir;
-  vo.frames_dir = options.frames_dir;
+  vo.frames_dir = staged_frames_dir;
   vo.frame_every_steps = options.frame_every;
   vo.frame_width_px = options.frame_width_px;
   vo.frame_height_px = options.frame_height_px;
   vo.wait_for_frames = options.lockstep;
-  vo.expected_host_steps = static_cast<std::size_t>(expected_s / host_dt_s);
+  vo.expected_host_steps = static_cast<std::size_t>(std::min(expected_s, kReservedView_s) / host_dt_s);
   std::string error;
   std::string notice;
   std::unique_ptr<viewer::SessionView> view = viewer::SessionView::start(view_model, vo, error, notice);
@@ -230,15 +322,11 @@ void run_lockstep(SessionParts& parts, const falcon::SimFalconConfig& sim_config
   RtChannels& channels = rt.channels();
   const double host_dt_s = parts.host_dt_s();
   const double ratio = host_dt_s / parts.model.period_s;
-  const auto ticks_per_host = static_cast<std::uint64_t>(std::llround(ratio));
-  if (ticks_per_host < 1 || std::abs(ratio - static_cast<double>(ticks_per_host)) > 1e-6 * ratio) {
-    throw SessionError("--lockstep: the host period (" + std::to_string(host_dt_s * 1e3) +
-                       " ms) must be a whole number of rt periods (" + std::to_string(parts.model.period_s * 1e3) + " ms)");
-  }
+  const auto ticks_per_host = static_cast<std::uint64_t>(std::llround(ratio));  // whole: check_lockstep_rates
   const auto end_ns = static_cast<TimeNs>(std::llround(parts.duration_s * 1e9));
   rt::TelemetrySample sample;
   while (!loop.stopped()) {
-    if (clock.now() >= end_ns || interrupted(parts.options)) loop.request_stop();
+    if (clock.now() >= end_ns || interrupted(parts.options) || !parts.recorder.figures().first_non_finite.empty()) loop.request_stop();
     for (std::uint64_t k = 0; k < ticks_per_host && !loop.stopped(); ++k) loop.step();
     const HostStatus& host_status = parts.host.step(channels.state, channels.proxy);
     parts.recorder.add_host_step(host_status);
@@ -263,13 +351,8 @@ void run_realtime(SessionParts& parts, const falcon::SimFalconConfig& sim_config
   const bool until_interrupted = parts.duration_s <= 0.0;
   MonotonicClock clock;
   std::unique_ptr<falcon::HapticDevice> device;
-  std::unique_ptr<UsbFalcon> usb;
-  if (options.device == SessionDevice::kUsb) {
-    usb = UsbFalcon::open(clock);
-  } else {
-    device = std::make_unique<falcon::SimFalcon>(sim_config, clock);
-  }
-  falcon::HapticDevice& haptic = usb ? usb->device() : *device;
+  if (parts.usb == nullptr) device = std::make_unique<falcon::SimFalcon>(sim_config, clock);
+  falcon::HapticDevice& haptic = parts.usb != nullptr ? parts.usb->device() : *device;
   out.device_name = haptic.name();
   RtStack rt(parts.model, haptic, clock);
   rt::RtLoop& loop = rt.loop();
@@ -314,7 +397,7 @@ void run_realtime(SessionParts& parts, const falcon::SimFalconConfig& sim_config
   };
   while (!rt_thread.done()) {
     std::this_thread::sleep_for(std::chrono::milliseconds(kDrainPeriod_ms));
-    if (interrupted(options)) stop_rt.store(true);
+    if (interrupted(options) || !parts.recorder.figures().first_non_finite.empty()) stop_rt.store(true);
     drain();
     if (parts.view != nullptr) parts.view->rt_figures().publish(parts.rt_figures.update(parts.recorder));
     out.session_time_s = to_seconds(clock.now() - start_ns);
@@ -391,8 +474,7 @@ nlohmann::json summary_json(const SessionParts& parts, const RunFigures& run, do
   summary["force_limit_n"] = parts.model.config.safety.max_force_n;
   summary["contact_force_max_n"] = f.contact_force_max_n;
   summary["host_force_max_n"] = f.host_force_max_n;
-  std::vector<double> ages = f.proxy_age_ms;
-  summary["proxy_age_ms"] = quantile_json(std::move(ages));
+  summary["proxy_age_ms"] = quantile_json(f.proxy_age_ms);
   summary["energy_j"] = f.energy_j;
   summary["energy_max_j"] = f.energy_max_j;
   summary["passivity_controller"] = options.passivity_controller;
@@ -405,8 +487,7 @@ nlohmann::json summary_json(const SessionParts& parts, const RunFigures& run, do
   if (!options.lockstep) {
     summary["wakeup_latency_us"] = {{"median", run.wakeup_median_us}, {"p99", run.wakeup_p99_us}, {"max", run.wakeup_max_us}};
     summary["max_tick_us"] = run.max_tick_us;
-    std::vector<double> intervals = f.tick_interval_us;
-    summary["tick_interval_us"] = quantile_json(std::move(intervals));
+    summary["tick_interval_us"] = quantile_json(f.tick_interval_us);
   }
   if (view_stats) {
     summary["view"] = view_json(options, *view_stats);
@@ -418,33 +499,53 @@ nlohmann::json summary_json(const SessionParts& parts, const RunFigures& run, do
   return summary;
 }
 
+/// Writes summary and plot under their temporary names, then moves every output into place
+/// (the summary last: its presence marks a complete run).
 SessionOutcome write_outcome(const SessionOptions& options, const host::SceneDescription& scene, const SessionRecorder& recorder,
-                             nlohmann::json summary) {
+                             OutputStaging& staging, nlohmann::json summary) {
   SessionOutcome outcome;
-  outcome.trace_path = recorder.trace_path();
-  outcome.summary_path = options.out_dir / "summary.json";
-  {
-    std::ofstream out(outcome.summary_path);
-    if (!out) throw SessionError("cannot write '" + outcome.summary_path.string() + "'");
-    out << summary.dump(2) << "\n";
-  }
+  outcome.trace_path = options.out_dir / "trace.csv";
   if (options.plot) {
     std::string error;
-    outcome.plot_path = plot_session(outcome.trace_path, options.out_dir / "session.png",
-                                     scene.name + (options.lockstep ? " (lockstep)" : " (real time)"), error);
-    if (outcome.plot_path.empty()) spdlog::warn("{}", error);
+    const std::filesystem::path png = staging.file(options.out_dir / "session.png");
+    if (plot_session(recorder.trace_path(), png, scene.name + (options.lockstep ? " (lockstep)" : " (real time)"), error).empty()) {
+      spdlog::warn("{}", error);
+    } else {
+      outcome.plot_path = options.out_dir / "session.png";
+    }
   }
+  outcome.summary_path = options.out_dir / "summary.json";
+  {
+    std::ofstream out(staging.file(outcome.summary_path));
+    out << summary.dump(2) << "\n";
+    if (!out) throw SessionError("cannot write '" + outcome.summary_path.string() + "'");
+  }
+  staging.commit();
   outcome.summary = std::move(summary);
   return outcome;
+}
+
+/// A run whose figures went non-finite has no valid outputs: say which quantity, and when.
+void require_finite(const SessionRecorder& recorder, const nlohmann::json& summary) {
+  const std::string& rt_or_host = recorder.figures().first_non_finite;
+  if (!rt_or_host.empty()) {
+    throw SessionError("the session produced a non-finite " + rt_or_host +
+                       "; nothing was written (the scene's values are the usual cause: see docs/scenes.md, \"Plausible values\")");
+  }
+  const std::string key = first_non_finite_key(summary, "");
+  if (!key.empty()) throw SessionError("the session's summary figure '" + key + "' is non-finite; nothing was written");
 }
 
 }  // namespace
 
 SessionOutcome run_session(const SessionOptions& options) {
+  // Everything that can be refused is refused here, before the device is opened, the soft body
+  // settles or any output is touched.
   const host::SceneDescription scene = scene_at_host_rate(options.scene, options.host_rate_hz);
   if (options.lockstep && options.device == SessionDevice::kUsb) {
-    throw SessionError("--lockstep runs on simulated time: it needs --device sim, not the USB Falcon");
+    throw SessionError("--lockstep runs on simulated time: it needs --device sim, not the USB Falcon", true);
   }
+  check_lockstep_rates(options, scene);
   rt::RtConfig config;
   config.rate_hz = options.rt_rate_hz;
   config.mapping = scene.device_mapping;
@@ -454,18 +555,28 @@ SessionOutcome run_session(const SessionOptions& options) {
   const double host_dt_s = scene.simulation.time_step_s;
   double duration_s = options.duration_s;
   if (duration_s <= 0.0 && options.device == SessionDevice::kSim) duration_s = hand_script_duration_s(scene.hand);
-  if (duration_s <= 0.0 && options.lockstep) throw SessionError("--lockstep needs a duration: the scene's hand script is empty");
+  if (duration_s <= 0.0 && options.lockstep) {
+    throw SessionError("--lockstep needs a duration: the scene's hand script is empty");
+  }
+  check_duration(options, scene, duration_s);
   const bool until_interrupted = duration_s <= 0.0;
+
+  MonotonicClock usb_clock;
+  std::unique_ptr<UsbFalcon> usb;
+  if (options.device == SessionDevice::kUsb) usb = UsbFalcon::open(usb_clock);
 
   SessionHost host(scene);
   host.settle(options.settle_s);
+  require_settled_on_ground(host.simulation(), scene, options.settle_s);
 
+  OutputStaging staging;
+  const std::filesystem::path staged_frames =
+      options.frames_dir.empty() ? std::filesystem::path() : staging.directory(options.frames_dir, "frame_", ".png");
   const double expected_s = until_interrupted ? 60.0 : duration_s + 1.0;
-  std::unique_ptr<viewer::SessionView> view = start_view(options, host, expected_s, host_dt_s);
-  SessionRecorder recorder(options.out_dir, static_cast<std::size_t>(expected_s * options.rt_rate_hz),
-                           static_cast<std::size_t>(expected_s / host_dt_s));
+  std::unique_ptr<viewer::SessionView> view = start_view(options, host, expected_s, host_dt_s, staged_frames);
+  SessionRecorder recorder(staging.file(options.out_dir / "trace.csv"));
   StatusPrinter status(options.status_line);
-  SessionParts parts{options, scene, model, host, recorder, status, view.get()};
+  SessionParts parts{options, scene, model, host, recorder, status, view.get(), usb.get()};
   parts.duration_s = duration_s;
   const WallClock::time_point wall_start = WallClock::now();
   falcon::SimFalconConfig sim_config;
@@ -481,7 +592,9 @@ SessionOutcome run_session(const SessionOptions& options) {
   std::optional<viewer::SessionViewStats> view_stats;
   if (view) view_stats = view->finish();
   const double wall_s = std::chrono::duration<double>(WallClock::now() - wall_start).count();
-  return write_outcome(options, scene, recorder, summary_json(parts, run, wall_s, view_stats));
+  nlohmann::json summary = summary_json(parts, run, wall_s, view_stats);
+  require_finite(recorder, summary);
+  return write_outcome(options, scene, recorder, staging, std::move(summary));
 }
 
 }  // namespace fissure::session

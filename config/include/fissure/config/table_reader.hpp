@@ -32,6 +32,17 @@ namespace fissure::config {
 /// 1-based line of a node in its file.
 [[nodiscard]] int line_of(const toml::node& node);
 
+/// 1-based line of the value at `dotted_path` (e.g. "hand.waypoint[0].position_device_m") in a
+/// configuration file, for checks made after loading; 0 when the file or the key is not there.
+[[nodiscard]] int line_of_field(const std::filesystem::path& file, std::string_view dotted_path) noexcept;
+
+/// "; is 'time_stp_s' (line 7) a misspelling of it?" when `table` has a key within two edits of
+/// `expected` (a typo the missing-field error should point at); "" otherwise.
+[[nodiscard]] std::string misspelling_hint(const toml::table& table, const std::string& expected);
+
+/// A number as a person reads it: 4 significant digits ("1.798e+308", never 300 digits).
+[[nodiscard]] std::string format_number(double value);
+
 /// Human name of a key's unit suffix ("m_per_s" → "metres per second"), for error messages.
 [[nodiscard]] std::string unit_name(const std::string& suffix);
 
@@ -65,7 +76,8 @@ class TableReader {
     const toml::node* node = find(stem, unit);
     if (node == nullptr) {
       const std::string key = unit.empty() ? stem : stem + "_" + unit;
-      fail(table_line(), key, "missing field (expected '" + key + "'" + (unit.empty() ? "" : ", in " + unit_name(unit)) + ")");
+      fail(table_line(), key,
+           "missing field (expected '" + key + "'" + (unit.empty() ? "" : ", in " + unit_name(unit)) + ")" + misspelling_hint(table_, key));
     }
     return *node;
   }
@@ -82,16 +94,14 @@ class TableReader {
   }
   double positive(const std::string& stem, const std::string& unit, std::optional<double> fallback = std::nullopt) {
     const double v = number(stem, unit, fallback);
-    if (!(v > 0.0)) fail(line_for(stem, unit), stem + "_" + unit, "must be > 0 (got " + std::to_string(v) + ")");
+    if (!(v > 0.0)) fail(line_for(stem, unit), stem + "_" + unit, "must be > 0 (got " + format_number(v) + ")");
     return v;
   }
   double in_range(const std::string& stem, const std::string& unit, double lo, double hi,
                   std::optional<double> fallback = std::nullopt) {
     const double v = number(stem, unit, fallback);
     if (v < lo || v > hi) {
-      std::ostringstream msg;
-      msg << "must be in [" << lo << ", " << hi << "] (got " << v << ")";
-      fail(line_for(stem, unit), stem + "_" + unit, msg.str());
+      fail(line_for(stem, unit), stem + "_" + unit, "must be in [" + format_number(lo) + ", " + format_number(hi) + "] (got " + format_number(v) + ")");
     }
     return v;
   }
@@ -161,7 +171,7 @@ class TableReader {
     used_.insert(key);
     const toml::node* node = table_.get(key);
     if (node == nullptr) {
-      if (required) fail(table_line(), key, "missing table [" + (path_.empty() ? key : path_ + "." + key) + "]");
+      if (required) fail(table_line(), key, "missing table [" + (path_.empty() ? key : path_ + "." + key) + "]" + misspelling_hint(table_, key));
       return nullptr;
     }
     if (!node->is_table()) fail_at(*node, key, "expected a table");

@@ -16,6 +16,27 @@
 
 namespace fissure::session {
 
+/// Samples of one figure for its quantiles, in bounded memory: every value while there are at most
+/// kCapacity (exact quantiles — every test and benchmark session), then a uniform reservoir
+/// sample (Vitter's algorithm R, fixed seed, so a lockstep run is still reproducible). A session
+/// of any length, e.g. a USB run left going all day, costs at most kCapacity doubles per figure.
+class SampleReservoir {
+ public:
+  /// 8 MiB of doubles: 17 min of ticks at 1 kHz kept exactly.
+  static constexpr std::size_t kCapacity = std::size_t{1} << 20;
+  void add(double value);
+  [[nodiscard]] std::uint64_t count() const noexcept { return count_; }
+  [[nodiscard]] bool exact() const noexcept { return count_ <= kCapacity; }
+  [[nodiscard]] double max() const noexcept { return max_; }
+  [[nodiscard]] const std::vector<double>& values() const noexcept { return values_; }
+
+ private:
+  std::vector<double> values_;
+  std::uint64_t count_ = 0;
+  double max_ = 0.0;
+  std::uint64_t rng_state_ = 0x9E3779B97F4A7C15ull;
+};
+
 struct SessionFigures {
   std::uint64_t ticks = 0;
   std::uint64_t overruns = 0;
@@ -35,18 +56,21 @@ struct SessionFigures {
   double host_penetration_max_m = 0.0;     ///< deepest soft node inside the tool (host)
   double host_force_max_n = 0.0;
   std::uint64_t host_steps = 0;
-  std::vector<double> proxy_age_ms;        ///< per tick with a proxy
-  std::vector<double> host_step_ms;        ///< per host step
+  SampleReservoir proxy_age_ms;            ///< per tick with a proxy
+  SampleReservoir host_step_ms;            ///< per host step
   /// Loop-clock time between consecutive telemetry samples [us]: the rt tick period as it
   /// happened (its jitter is what competition for the CPU, e.g. the view, would show up in).
-  std::vector<double> tick_interval_us;
+  SampleReservoir tick_interval_us;
+  /// The first non-finite quantity seen ("" while all are finite), e.g. "rt tool position
+  /// (tick 1234, t = 1.234 s)": a run that produced one has no valid outputs.
+  std::string first_non_finite;
 };
 
 class SessionRecorder {
  public:
-  /// Opens `out_dir`/trace.csv (creating the directory). Throws SessionError naming the file
-  /// when it cannot. `expected_ticks` sizes the buffers once.
-  SessionRecorder(const std::filesystem::path& out_dir, std::size_t expected_ticks, std::size_t expected_host_steps);
+  /// Opens `trace_path` for writing (its directory must exist: OutputStaging makes it). Throws
+  /// SessionError naming the file when it cannot.
+  explicit SessionRecorder(const std::filesystem::path& trace_path);
   ~SessionRecorder();
   SessionRecorder(const SessionRecorder&) = delete;
   SessionRecorder& operator=(const SessionRecorder&) = delete;
@@ -59,13 +83,13 @@ class SessionRecorder {
   /// The newest telemetry sample added (zeros before the first).
   [[nodiscard]] const rt::TelemetrySample& last_tick() const noexcept { return last_; }
   [[nodiscard]] const std::filesystem::path& trace_path() const noexcept { return trace_path_; }
-  [[nodiscard]] const std::filesystem::path& out_dir() const noexcept { return out_dir_; }
 
   /// One status line (no newline): time, tick rate, force, proxy age, overruns, crossed nodes.
   [[nodiscard]] std::string status_line(double time_s, double tick_rate_hz, double host_rate_hz) const;
 
  private:
-  std::filesystem::path out_dir_;
+  void note_non_finite(const char* quantity, double time_s, std::uint64_t tick);
+
   std::filesystem::path trace_path_;
   std::FILE* trace_ = nullptr;
   SessionFigures figures_;
@@ -80,6 +104,8 @@ struct Quantiles {
   double max = 0.0;
 };
 Quantiles quantiles(std::vector<double>& values);
+/// The same over a reservoir (its max is exact even when its quantiles are sampled).
+Quantiles quantiles(const SampleReservoir& samples);
 
 /// Finds tools/plot_session.py (FISSURE_TOOLS_DIR, ./tools, or up from the executable) and runs
 /// it with Debian's /usr/bin/python3 on the trace; returns the PNG path, or "" and `error`.
