@@ -11,6 +11,7 @@
 #include "fissure/session/console_log.hpp"
 #include "fissure/session/host_loop.hpp"
 #include "fissure/session/link_bridge.hpp"
+#include "fissure/session/scene_plausibility.hpp"
 #include "fissure/session/session_error.hpp"
 #include "fissure/session/session_host.hpp"
 #include "fissure/session/split_device.hpp"
@@ -38,7 +39,11 @@ HostEndOutcome run_host_end(const HostEndOptions& options) {
   } catch (const std::exception& e) {
     throw SessionError(e.what());
   }
+  const Eigen::AlignedBox3d loaded_bounds = host->simulation().soft_bounds_world_m();
   host->settle(options.settle_s);
+  const std::string settle_warning =
+      check_settled_on_ground(loaded_bounds, host->simulation().soft_bounds_world_m(), scene, options.settle_s);
+  if (!settle_warning.empty()) std::fprintf(stderr, "fissure host: warning: %s\n", settle_warning.c_str());
 
   const double host_dt_s = scene.simulation.time_step_s;
   const auto period_ns = static_cast<TimeNs>(std::llround(host_dt_s * 1e9));

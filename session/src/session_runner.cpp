@@ -566,8 +566,11 @@ SessionOutcome run_session(const SessionOptions& options) {
   if (options.device == SessionDevice::kUsb) usb = UsbFalcon::open(usb_clock);
 
   SessionHost host(scene);
+  const Eigen::AlignedBox3d loaded_bounds = host.simulation().soft_bounds_world_m();
   host.settle(options.settle_s);
-  require_settled_on_ground(host.simulation(), scene, options.settle_s);
+  const std::string settle_warning =
+      check_settled_on_ground(loaded_bounds, host.simulation().soft_bounds_world_m(), scene, options.settle_s);
+  if (!settle_warning.empty()) spdlog::warn("{}", settle_warning);
 
   OutputStaging staging;
   const std::filesystem::path staged_frames =

@@ -8,7 +8,8 @@
 #include <string_view>
 #include <vector>
 
-#include "fissure/host_sim/host_simulation.hpp"
+#include <Eigen/Geometry>
+
 #include "fissure/host_sim/scene_description.hpp"
 
 namespace fissure::session {
@@ -29,9 +30,13 @@ void require_plausible(const host::SceneDescription& scene);
 
 /// After settling, the soft body must still rest on the ground. Bullet finds soft-vs-ground
 /// contact once per step, so a host step too long for the fall lets the body pass through the
-/// ground's box, and everything after is meaningless. Throws SessionError naming
-/// simulation.time_step_s (the loader's range allows steps this can happen at).
-void require_settled_on_ground(const host::HostSimulation& simulation, const host::SceneDescription& scene, double settle_s);
+/// ground's box, and everything after is meaningless: throws SessionError naming
+/// simulation.time_step_s (the loader's range allows steps this happens at). A body that stayed
+/// on the ground but settled to under half its height (a coarse step flattens it; so does a
+/// very soft material, which may be meant) gets a one-line warning, returned ("" when none).
+[[nodiscard]] std::string check_settled_on_ground(const Eigen::AlignedBox3d& loaded_bounds_world_m,
+                                                  const Eigen::AlignedBox3d& settled_bounds_world_m,
+                                                  const host::SceneDescription& scene, double settle_s);
 
 /// resolve_scene_path + load_scene + require_plausible: how the commands open a scene.
 [[nodiscard]] host::SceneDescription load_plausible_scene(std::string_view name_or_path);
