@@ -106,10 +106,14 @@ std::string format_bridge_status(const BridgeStatus& status, wire::Role role) {
   } else {
     std::snprintf(age, sizeof age, "%.1f ms", to_seconds(status.peer_data_age_ns) * 1e3);
   }
-  const char* link = status.failed ? "link REFUSED" : (status.established ? "link up" : "link waiting");
+  // A handshake once done is not a live link: a silent peer (dead, or cut off) is "link lost".
+  const char* link = status.failed                               ? "link REFUSED"
+                     : !status.established                       ? "link waiting"
+                     : status.peer_silent                        ? "link LOST"
+                                                                 : "link up";
   char line[256];
   std::snprintf(line, sizeof line, "%s | %s %s%s | in %llu out %llu | discards %llu frames / %llu msgs | restarts %llu",
-                link, age_name, age, status.established && status.peer_silent ? " (SILENT)" : "",
+                link, age_name, age, status.established && status.peer_silent ? " (peer silent)" : "",
                 static_cast<unsigned long long>(status.messages_in), static_cast<unsigned long long>(status.messages_out),
                 static_cast<unsigned long long>(status.frames_discarded),
                 static_cast<unsigned long long>(status.messages_discarded),

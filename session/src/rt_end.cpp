@@ -34,6 +34,23 @@ bool interrupted(const RtEndOptions& options) {
   return options.interrupt != nullptr && options.interrupt->load(std::memory_order_relaxed);
 }
 
+/// What happened to the link, for the summary line: "never established", "established at 0.31 s,
+/// host live to the end", "established at 0.31 s, host lost at 3.20 s (2 losses)". A host that
+/// stops and one that dies look the same from here: the wire has no goodbye message.
+std::string describe_link(const RtEndOutcome& outcome) {
+  if (!outcome.link_established) return "never established";
+  char text[160];
+  if (outcome.host_lost_at_s >= 0.0) {
+    std::snprintf(text, sizeof text, "established at %.2f s, host silent from %.2f s to the end (%llu loss%s)",
+                  outcome.link_established_at_s, outcome.host_lost_at_s, static_cast<unsigned long long>(outcome.host_losses),
+                  outcome.host_losses == 1 ? "" : "es");
+  } else {
+    std::snprintf(text, sizeof text, "established at %.2f s, host live at the end (%llu loss%s)", outcome.link_established_at_s,
+                  static_cast<unsigned long long>(outcome.host_losses), outcome.host_losses == 1 ? "" : "es");
+  }
+  return text;
+}
+
 }  // namespace
 
 RtEndOutcome run_rt_end(const RtEndOptions& options) {
@@ -103,6 +120,7 @@ RtEndOutcome run_rt_end(const RtEndOptions& options) {
     status_exchange.try_fetch(link);
     if (link.established && !outcome.link_established) {
       outcome.link_established = true;
+      outcome.link_established_at_s = to_seconds(clock.now() - start_ns);
       log_info("link established with the host");
     }
     if (link.failed) stop_rt.store(true);  // a refused peer sends nothing usable: ramp out and stop
@@ -110,6 +128,8 @@ RtEndOutcome run_rt_end(const RtEndOptions& options) {
     const bool host_live = link.established && !link.peer_silent;
     if (host_was_live && !host_live) {
       silent_since_ns = clock.now();
+      outcome.host_lost_at_s = to_seconds(silent_since_ns - kHostSilentAfter_ns - start_ns);
+      ++outcome.host_losses;
       fade_reported = false;
       log_warn("host silent (no proxy for %.0f ms): rt_core fades the force to zero", to_seconds(kHostSilentAfter_ns) * 1e3);
     }
@@ -119,6 +139,7 @@ RtEndOutcome run_rt_end(const RtEndOptions& options) {
     }
     if (!host_was_live && host_live && silent_since_ns != 0) {
       log_info("host back after %.0f ms", to_seconds(clock.now() - silent_since_ns) * 1e3);
+      outcome.host_lost_at_s = -1.0;
     }
     host_was_live = host_live;
     const auto now = std::chrono::steady_clock::now();
@@ -146,11 +167,12 @@ RtEndOutcome run_rt_end(const RtEndOptions& options) {
   outcome.host_restarts = link.peer_restarts;
   outcome.proxies_rejected = rt.loop().data().proxy.rejected_count;
   outcome.interrupted = interrupted(options);
+  const std::string link_story = describe_link(outcome);
   std::printf("%s: %.2f s, %llu ticks, overruns %llu | link %s | proxies used %llu | force max %.2f N | "
               "discards %llu frames / %llu msgs | host restarts %llu | device fault ticks %llu | proxies rejected %llu | "
               "stale-proxy ticks %llu%s\n",
               options.program, outcome.seconds, static_cast<unsigned long long>(outcome.ticks),
-              static_cast<unsigned long long>(outcome.overruns), outcome.link_established ? "established" : "never established",
+              static_cast<unsigned long long>(outcome.overruns), link_story.c_str(),
               static_cast<unsigned long long>(outcome.proxies_used), outcome.force_max_n,
               static_cast<unsigned long long>(outcome.frames_discarded), static_cast<unsigned long long>(outcome.messages_discarded),
               static_cast<unsigned long long>(outcome.host_restarts), static_cast<unsigned long long>(outcome.device_fault_ticks),
@@ -158,6 +180,10 @@ RtEndOutcome run_rt_end(const RtEndOptions& options) {
               outcome.interrupted ? " | stopped by Ctrl-C" : "");
   std::fflush(stdout);
   if (link.failed) throw SessionError(link.error);
+  if (!outcome.link_established) {
+    throw SessionError("no host answered on " + options.transport +
+                       ": link never established (is `fissure host` running with its --transport pointing at this end?)");
+  }
   return outcome;
 }
 

@@ -97,7 +97,7 @@ std::string ms_text(double seconds) {
   return text;
 }
 
-std::string hz_text(double hz) {
+std::string plain_number(double hz) {
   char text[48];
   std::snprintf(text, sizeof text, "%.6g", hz);
   return text;
@@ -114,20 +114,20 @@ void check_lockstep_rates(const SessionOptions& options, const host::SceneDescri
   if (ticks >= 1 && std::abs(ratio - static_cast<double>(ticks)) <= 1e-6 * ratio) return;
   const std::string host_source = options.host_rate_hz > 0.0 ? "--host-rate" : "the scene's simulation.time_step_s";
   std::string message = "--lockstep: the host step (" + ms_text(host_dt_s) + ", " + host_source +
-                        ") must be a whole number of rt periods (" + ms_text(rt_period_s) + " at --rate " + hz_text(options.rt_rate_hz) +
+                        ") must be a whole number of rt periods (" + ms_text(rt_period_s) + " at --rate " + plain_number(options.rt_rate_hz) +
                         " Hz)";
   std::string rates;
   int suggested = 0;
   for (long n = std::max(1L, static_cast<long>(std::ceil(kMinRtRate_hz * host_dt_s - 1e-9)));
        suggested < kRateSuggestions && static_cast<double>(n) / host_dt_s <= kMaxRtRate_hz * (1.0 + 1e-9); ++n, ++suggested) {
-    rates += (rates.empty() ? "" : ", ") + hz_text(static_cast<double>(n) / host_dt_s);
+    rates += (rates.empty() ? "" : ", ") + plain_number(static_cast<double>(n) / host_dt_s);
   }
   if (!rates.empty()) {
     message += ": use --rate " + rates;
   } else {
     message += ": the host step is " + std::string(ratio < 1.0 ? "shorter than one rt period" : "too long") +
                " for any --rate in 500..10000 Hz; use --host-rate H with a whole number of rt periods per host step (e.g. --host-rate " +
-               hz_text(options.rt_rate_hz) + ")";
+               plain_number(options.rt_rate_hz) + ")";
   }
   throw SessionError(message, true);
 }
@@ -137,7 +137,7 @@ void check_duration(const SessionOptions& options, const host::SceneDescription&
   if (duration_s <= kMaxSessionDuration_s) return;
   const std::string source =
       options.duration_s > 0.0 ? "--duration" : "the hand script of " + scene.source_path + " (its legs and hold_s)";
-  throw SessionError(source + " makes the session " + hz_text(duration_s) + " s long; at most " + hz_text(kMaxSessionDuration_s) +
+  throw SessionError(source + " makes the session " + plain_number(duration_s) + " s long; at most " + plain_number(kMaxSessionDuration_s) +
                          " s (one day) per session",
                      options.duration_s > 0.0);
 }

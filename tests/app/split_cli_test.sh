@@ -25,6 +25,8 @@ if ! grep -qs can /proc/net/protocols; then
   expect 1 "AF_CAN" hil latency --transport can:vcan0 --seconds 1 --json "$out/can.json"
 fi
 port=$((40000 + ($$ + 7) % 20000))
+# An rt end no host ever answered did nothing: it says so and fails (issue 25).
+expect 1 "link never established" rt --transport "udp:127.0.0.1:$((port + 1))" --seconds 0.3 --quiet
 for transport in inproc "udp:127.0.0.1:${port}"; do
   json="$out/hil.json"
   if ! timeout 60 "$fissure" hil latency --transport "$transport" --seconds 1 --settle 0.2 --json "$json" >"$out/stdout" 2>&1; then

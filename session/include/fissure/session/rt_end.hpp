@@ -35,6 +35,11 @@ struct RtEndOutcome {
   std::uint64_t ticks = 0;
   std::uint64_t overruns = 0;
   bool link_established = false;
+  double link_established_at_s = -1.0;  ///< session time of the handshake (-1: never)
+  /// Session time the host's proxies stopped (last fresh proxy) when it was still silent at the
+  /// end; -1 when it was live at the end or never connected.
+  double host_lost_at_s = -1.0;
+  std::uint64_t host_losses = 0;        ///< times the host went silent after being live
   std::uint64_t proxies_used = 0;
   double force_max_n = 0.0;
   std::uint64_t frames_discarded = 0;
@@ -46,9 +51,10 @@ struct RtEndOutcome {
   bool interrupted = false;
 };
 
-/// Runs the rt end and prints its one-line summary on stdout. Throws SessionError when the
-/// set-up fails (device, carrier, rt config, an enforced real-time policy refused) or the host
-/// was refused by the handshake.
+/// Runs the rt end and prints its one-line summary on stdout (the link: never established,
+/// established at t, host silent from t). Throws SessionError when the set-up fails (device,
+/// carrier, rt config, an enforced real-time policy refused), the host was refused by the
+/// handshake, or no host ever connected.
 RtEndOutcome run_rt_end(const RtEndOptions& options);
 
 }  // namespace fissure::session

@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# What `fissure run` / `fissure sim` leave on disk and say when refused (issue 25): a run refused
+# before it starts (no Falcon, a lockstep rate that does not divide, a duration over a day, a
+# ball that falls through the ground) leaves an earlier run's files byte for byte; a scene name
+# that is no file lists the known scenes and where it looked; a directory is called one.
+set -u
+fissure=${1:?usage: session_outputs_test.sh <path to fissure>}
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fail=0
+bad() { echo "FAIL: $*"; fail=1; }
+expect_refusal() {  # expect_refusal <text> <args…>: exit 1 or 2, one line containing <text>
+  local text="$1"; shift
+  local out rc
+  out=$("$fissure" "$@" 2>&1 >/dev/null); rc=$?
+  [[ $rc -eq 1 || $rc -eq 2 ]] || { bad "fissure $* exited $rc (output: $out)"; return; }
+  [[ $(wc -l <<<"$out") -eq 1 ]] || bad "fissure $* printed more than one line:"$'\n'"$out"
+  grep -qF -- "$text" <<<"$out" || bad "fissure $*: want '$text', got: $out"
+}
+
+run_dir="$work/run"
+"$fissure" run spatula-sphere --lockstep --no-plot --quiet --out "$run_dir" >/dev/null 2>&1 || bad "the lockstep run failed"
+[[ -s $run_dir/trace.csv && -s $run_dir/summary.json ]] || bad "the lockstep run wrote no trace or summary"
+before=$(cd "$run_dir" && md5sum trace.csv summary.json)
+
+if "$fissure" device probe >/dev/null 2>&1; then
+  echo "a Falcon is attached: the --device usb refusal is not checked"
+else
+  expect_refusal "--device usb" run spatula-sphere --device usb --duration 0.1 --quiet --out "$run_dir"
+fi
+expect_refusal "use --rate 1000, 2000, 3000, 4000" run spatula-sphere --lockstep --rate 700 --quiet --out "$run_dir"
+expect_refusal "at most 86400 s" run spatula-sphere --lockstep --duration 1e9 --quiet --out "$run_dir"
+sed 's/^time_step_s = 0.001 /time_step_s = 0.1   /' scenes/spatula-sphere.toml >"$work/coarse.toml"
+expect_refusal "fell through the ground while settling" run "$work/coarse.toml" --lockstep --quiet --out "$run_dir"
+after=$(cd "$run_dir" && md5sum trace.csv summary.json)
+[[ $before == "$after" ]] || bad "a refused run changed the earlier outputs:"$'\n'"$before"$'\n'"$after"
+[[ -z $(ls -A "$run_dir" | grep -v -x -e trace.csv -e summary.json) ]] || bad "temporaries left in $run_dir: $(ls -A "$run_dir")"
+
+echo "earlier csv" >"$work/sim.csv"
+expect_refusal "fell through the ground while settling" sim "$work/coarse.toml" --settle-seconds 1 --csv "$work/sim.csv"
+[[ $(cat "$work/sim.csv") == "earlier csv" ]] || bad "a refused fissure sim overwrote its --csv file"
+expect_refusal "at most 86400 s" sim spatula-sphere --seconds 1e9
+
+expect_refusal "known scenes: clamp-sphere, clamp-vessel, convex-spatula-sphere, spatula-sphere" run no-such-scene --lockstep
+expect_refusal "is a directory, not a scene file" run "$work" --lockstep
+
+[[ $fail -eq 0 ]] && echo "session outputs hold"
+exit $fail
