@@ -13,7 +13,6 @@
 #include "fissure/falcon_hw/kinematics.hpp"
 #include "fissure/host_sim/scene_loader.hpp"
 #include "fissure/session/session_error.hpp"
-#include "fissure/shared/device_mapping.hpp"
 
 namespace fissure::session {
 namespace {
