@@ -137,17 +137,21 @@ TickResult tick(const RtModel& model, RtData& data, TickIo& io, const TickTiming
     Eigen::Vector3d new_force = Eigen::Vector3d::Zero();
     data.max_penetration_m = -1.0;
     data.patches_in_contact = 0;
+    double stored_energy_j = 0.0;
     if (data.proxy.have_proxy) {
       const ContactEvaluation evaluation =
-          evaluate_proxy(active_proxy(data.proxy), config.mapping, data.tool, data.part_forces);
+          evaluate_proxy(active_proxy(data.proxy), config.mapping, data.tool, data.part_forces, model.damping_cap);
       data.max_penetration_m = evaluation.max_penetration_m;
       data.patches_in_contact = evaluation.patches_in_contact;
       new_force = part_forces_to_device(config.mapping, data.part_forces);
+      // The staleness fade and safety's ramp scale the rendered spring, and with it what it stores.
+      stored_energy_j = fade_gain * data.safety.ramp_gain * model.device_energy_per_world_energy *
+                        evaluation.stored_energy_world_j;
     }
     if (intake == ProxyIntake::kAccepted) {
       Eigen::Vector3d old_force = Eigen::Vector3d::Zero();  // the first proxy blends in from zero
       if (data.proxy.have_previous) {
-        evaluate_proxy(previous_proxy(data.proxy), config.mapping, data.tool, data.part_forces);
+        evaluate_proxy(previous_proxy(data.proxy), config.mapping, data.tool, data.part_forces, model.damping_cap);
         old_force = part_forces_to_device(config.mapping, data.part_forces);
       }
       begin_swap(data.blend, old_force, new_force);
@@ -166,7 +170,7 @@ TickResult tick(const RtModel& model, RtData& data, TickIo& io, const TickTiming
     const Eigen::Vector3d environment_device_n =
         data.contact_force_device_n + workspace_soft_wall_n(config.safety, data.p_device_m, flags);
     force = passivity_control(config.passivity, data.passivity, environment_device_n, data.v_device_m_per_s,
-                              data.velocity.x1, model.period_s);
+                              data.velocity.x1, model.period_s, stored_energy_j);
     if ((data.passivity.damping_n_s_per_m) > 0.0) flags |= kFlagPassivityActive;
   } else {
     data.contact_force_device_n.setZero();
