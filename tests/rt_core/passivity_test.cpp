@@ -699,8 +699,8 @@ TEST(PassivityClosedLoop, AFlickOutOfAStiffDampedContactStaysWithinTheEnergyBoun
 }
 
 // With the reduction's reference following the stored energy (the deep contact stores what it
-// returns) g alone keeps these flicks within the bound, even with no energy bound at all (5.5 mJ
-// measured); before it, the same flicks reached 29–30 mJ without energy bounding.
+// returns, so the debt is what it returns beyond that) g keeps these flicks within the bound
+// even without the energy bound at speed.
 TEST(PassivityClosedLoop, TheStoredEnergyReferenceAloneKeepsTheFlickWithinTheBound) {
   PassivityConfig no_bounding;
   no_bounding.energy_bounding = false;

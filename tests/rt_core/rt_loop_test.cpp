@@ -203,10 +203,10 @@ TEST(RtLoop, TheSameStiffWallIsActiveWithoutThePassivityController) {
 // Issue 26: a hand that hits a 3000 N/m wall (the Falcon's rated stiffness) at 0.5 m/s and then
 // rests against it, 8 mm past the surface through its 300 N/m grip (≈ 2.2 N), at 1 kHz. The
 // impact makes the sampled wall return a little more than it stored, so the observer's E
-// ends above its old fixed reference −margin; a controller that held its reduction while the
-// hand rested rendered the wall near 0 N from then on (1.65e-4 of its force at 1192 N/m). The
-// reference follows the wall's stored energy, and g gives the force back while nothing is
-// returned, so the hand gets the wall's force within 100 ms of the impact and keeps it.
+// ends above a fixed reference −margin, and a reduction held while the hand rests would render
+// the wall near 0 N from then on. The reference follows the wall's stored energy, the device's
+// damper is credited with what it dissipated, and g gives the force back once that debt is
+// paid, so the hand gets the wall's force within 100 ms of the impact and keeps it.
 struct RestingHandResult {
   double contact_s = -1.0;
   double min_ratio_after_100ms = 1e9;  ///< commanded / wall force, from contact + 100 ms on

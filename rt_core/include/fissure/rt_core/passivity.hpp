@@ -147,16 +147,17 @@ inline constexpr double kPassivityRecoveryForgiveness_j = 10.0 * kDefaultPassivi
 inline constexpr double kPassivityMaxDampingCredit_j =
     kFalconMaxForce_n * kFalconMaxForce_n / (2.0 * kFalconMaxStiffness_n_per_m);
 
-/// Largest damping β the controller adds [N·s/m]: 6 N·s/m, chosen by measurement (fissure bench
-/// rt, docs/decisions.md, issue 26). β acts on the filtered velocity v_f (2nd-order, 100 Hz at
-/// 1 kHz), whose gain near the Nyquist rate — where the sampled-data activity Colgate–Schenkel's
-/// b > K·T/2 + |B| is about lives — is a small fraction of its gain at the contact resonance
-/// (15–30 Hz with the hand), so β may exceed the device's b there without turning active: with
-/// it the bench's walls stay passive (device damper counted) at every rate. At 2 N·s/m (below b)
-/// a 3000 N/m wall at 1 kHz kept a 1 mm limit cycle (held back to 56 % of its stiffness);
-/// at 4 N·s/m the Z-width at 1 kHz was 2910 N/m, at 6 N·s/m 3638 N/m. Far below CHAI3D's
-/// 20 N·s/m Falcon limit (BRIEF §5).
-inline constexpr double kDefaultPassivityMaxDamping_n_s_per_m = 6.0;
+/// Largest damping β the controller adds [N·s/m]: 5 N·s/m, chosen by measurement (fissure bench
+/// rt and the rt_stall stress case, docs/decisions.md, issue 26). β acts on the filtered
+/// velocity v_f (2nd-order, 100 Hz at 1 kHz), whose gain near the Nyquist rate — where the
+/// sampled-data activity Colgate–Schenkel's b > K·T/2 + |B| is about lives — is a small fraction
+/// of its gain at the contact resonance (15–30 Hz with the hand), so β may exceed the device's b
+/// there without turning active: the bench's walls stay passive (device damper counted) at every
+/// rate. Lower holds the wall back: at 2 N·s/m a 3000 N/m wall at 1 kHz kept a 1 mm limit cycle
+/// (rendered at 56 % of its stiffness), at 4 N·s/m the next grid point after 2910 N/m (3638) buzzed.
+/// Higher distorts a hold: β·v_f against a contact the host makes buzz at ~60 Hz, ±15 mm/s, is
+/// 5.6 % of a 2 N force at 6 N·s/m (4.7 % at 5). Far below CHAI3D's 20 N·s/m Falcon limit (BRIEF §5).
+inline constexpr double kDefaultPassivityMaxDamping_n_s_per_m = 5.0;
 
 struct PassivityConfig {
   bool enabled = true;
