@@ -587,7 +587,7 @@ RestingHandRun run_resting_hand(double stiffness_n_per_m, bool passivity_on) {
 // 4. The resting hand after an impact, controller on and off, into `out`.
 void measure_resting_hand(nlohmann::json& out) {
   std::printf("\n4. Resting hand (lockstep, 1 kHz): 0.5 m/s onto a 3000 N/m wall, then 1 s at rest 8 mm past it\n");
-  std::printf("   %-8s %12s %22s %14s %14s %12s\n", "PC", "contact [s]", ">=90%% from contact +", "min ratio>100ms",
+  std::printf("   %-8s %12s %22s %14s %14s %12s\n", "PC", "contact [s]", ">=90% from contact +", "min ratio>100ms",
               "wall F end", "cmd F end");
   nlohmann::json rows = nlohmann::json::array();
   for (const bool on : {true, false}) {
