@@ -1,6 +1,7 @@
 #include "fissure/eval/stress_cases.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -649,24 +650,48 @@ class Checker {
   }
 
   // From kStressStallRecovery_s after a stall, for kStressStallCheck_s: the commanded force
-  // within kStressStallForceTolerance of the contact force (where that is ≥ kStressStallMinForce_n).
+  // within kStressStallForceTolerance of the contact force (where that is ≥ kStressStallMinForce_n),
+  // both as their means over the last kStressStallMeanWindow_s (stress_cases.hpp says why).
   void check_after_stall(const rt::TelemetrySample& s, double t_s) {
     while (next_stall_ < setup_.rt_stalls.size() &&
            t_s >= setup_.rt_stalls[next_stall_].end_s + kStressStallRecovery_s + kStressStallCheck_s) {
       ++next_stall_;
     }
-    if (next_stall_ >= setup_.rt_stalls.size() || t_s < setup_.rt_stalls[next_stall_].end_s + kStressStallRecovery_s) return;
-    const double contact_n = norm3(s.contact_force_device_n);
+    if (next_stall_ >= setup_.rt_stalls.size()) return;
+    const double window_start_s = setup_.rt_stalls[next_stall_].end_s + kStressStallRecovery_s;
+    if (t_s < window_start_s - kStressStallMeanWindow_s) {
+      mean_samples_ = 0;
+      return;
+    }
+    const auto window_ticks = static_cast<std::size_t>(std::lround(kStressStallMeanWindow_s / period_s_));
+    const std::size_t slot = mean_samples_++ % kMeanRingSize;
+    commanded_ring_[slot] = as_eigen(s.force_device_n);
+    contact_ring_[slot] = as_eigen(s.contact_force_device_n);
+    if (t_s < window_start_s || mean_samples_ < window_ticks) return;
+    Eigen::Vector3d commanded = Eigen::Vector3d::Zero(), contact = Eigen::Vector3d::Zero();
+    for (std::size_t k = 0; k < window_ticks; ++k) {
+      const std::size_t i = (mean_samples_ - 1 - k) % kMeanRingSize;
+      commanded += commanded_ring_[i];
+      contact += contact_ring_[i];
+    }
+    commanded /= static_cast<double>(window_ticks);
+    contact /= static_cast<double>(window_ticks);
+    const double contact_n = contact.norm();
     if (!(contact_n >= kStressStallMinForce_n)) return;
-    const Vec3& f = s.force_device_n;
-    const Vec3& c = s.contact_force_device_n;
-    const double error = norm3({f[0] - c[0], f[1] - c[1], f[2] - c[2]}) / contact_n;
+    const double error = (commanded - contact).norm() / contact_n;
     ++row_.stall_checked_ticks;
     row_.stall_force_error_max = std::max(row_.stall_force_error_max, error);
     if (error > kStressStallForceTolerance) {
       fail("rt stall: commanded force not within 5 % of the contact force 200 ms after the stall", t_s);
     }
   }
+
+  /// Ring of the last commanded and contact forces for check_after_stall's means (≥ the window's
+  /// ticks at the fastest rate, 10 kHz × kStressStallMeanWindow_s).
+  static constexpr std::size_t kMeanRingSize = 256;
+  std::array<Eigen::Vector3d, kMeanRingSize> commanded_ring_{};
+  std::array<Eigen::Vector3d, kMeanRingSize> contact_ring_{};
+  std::size_t mean_samples_ = 0;
 
   StressRow& row_;
   const StressSetup& setup_;

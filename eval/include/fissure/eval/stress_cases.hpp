@@ -54,8 +54,15 @@ inline constexpr double kAnchorCapHeight_m = 0.01;
 inline constexpr double kStressStallRecovery_s = 0.2;
 /// …and stay there for this long [s] (the hand keeps resting; the check window).
 inline constexpr double kStressStallCheck_s = 0.2;
-/// Largest |F_commanded − F_contact| / |F_contact| in the check window (issue 26: 5 %).
+/// Largest |F_commanded − F_contact| / |F_contact| in the check window (issue 26: 5 %), both
+/// forces averaged over kStressStallMeanWindow_s.
 inline constexpr double kStressStallForceTolerance = 0.05;
+/// The window those means are taken over [s]: 20 ms, one period of 50 Hz. A resting hand on the
+/// spatula-sphere contact buzzes at ~60 Hz by ±15 mm/s, and the passivity damper β·v_f (≤ 5 N·s/m)
+/// ripples the command by ±0.075 N about the contact force with it — zero on average, and not the
+/// held-back force this check is about (issue 26: 1.1 N commanded against 1.35 N, with a
+/// 20–25 Hz sawtooth, which a 20 ms mean passes at ≥ 60 % of its amplitude).
+inline constexpr double kStressStallMeanWindow_s = 0.02;
 /// Contact forces below this [N] are not checked against the relative tolerance: there 5 % is
 /// below the wall's own step per encoder count.
 inline constexpr double kStressStallMinForce_n = 0.2;
@@ -175,8 +182,8 @@ struct StressRow {
   /// (Bullet's signed volume, so < 0 means the surface is turned inside out: the one-sided paired
   /// collision then meets no triangle from outside — a failure the crossed-node count cannot see).
   double soft_volume_ratio_min = 1.0;
-  /// After rt stalls: largest |F_commanded − F_contact| / |F_contact| in the check windows, and
-  /// how many ticks were checked.
+  /// After rt stalls: largest |F_commanded − F_contact| / |F_contact| in the check windows (20 ms
+  /// means), and how many ticks were checked.
   double stall_force_error_max = 0.0;
   std::uint64_t stall_checked_ticks = 0;
   double wall_s = 0.0;
