@@ -68,6 +68,10 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
   const double raw_force_n = force_device_n.norm();
   const double clamp_share = raw_force_n > config.max_force_n ? config.max_force_n / raw_force_n : 1.0;
   const double stored_j = std::max(0.0, stored_energy_j) * clamp_share * (2.0 - clamp_share);
+  if (state.forgive_stored_energy) {
+    state.recovery_forgiven_j += stored_j;
+    state.forgive_stored_energy = false;
+  }
   // Forgiven work already dissipated is no longer owed (see forgiven_j): not beyond the debt.
   state.recovery_forgiven_j =
       std::min(state.recovery_forgiven_j, std::max(0.0, state.energy_j + stored_j + config.margin_j));
@@ -97,11 +101,15 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
   // is still owed is kept (free motion does not pre-pay the next contact).
   if (force_device_n.isZero(0.0)) state.damping_credit_j = std::min(state.damping_credit_j, std::max(0.0, debt_j + config.margin_j));
   const double debt_excess_j = debt_j - state.damping_credit_j + config.margin_j;
-  // While the debt is above the reference g holds (giving the force back while the hand pushes
+  // The same debt if g stays as it is: the rendered spring is (1 − g) of the environment's and
+  // stores (1 − g)·U, so a contact pressed with g in effect owes nothing for the part withheld.
+  const double kept_debt_excess_j = debt_excess_j - state.reduction_fraction * stored_j;
+  // While that debt is above the reference g holds (giving the force back while the hand pushes
   // in would store energy the environment returns later; at standstill nothing is paid back)
   // and grows while the environment returns energy (below); once it is paid — by g, by β, or by
-  // the device's own damper — g gives the force back, at a hold too: nothing is owed there.
-  double target = debt_excess_j > 0.0 ? state.reduction_fraction : 0.0;
+  // the device's own damper — g gives the force back, at a hold too: nothing is owed there
+  // (what the full force then stores is owed, and withheld, on the way out).
+  double target = kept_debt_excess_j > 0.0 ? state.reduction_fraction : 0.0;
   double raise_step_n = config.max_correction_step_n;
 
   if (speed >= config.min_speed_m_per_s) {
@@ -213,6 +221,7 @@ void record_sent_force(PassivityState& state, const Eigen::Vector3d& force_devic
 void restart_observer(PassivityState& state) noexcept {
   close_recovery_window(state);  // a fault inside a window: that window's account closes here
   state.primed = false;
+  state.forgive_stored_energy = true;
   state.recovery_window_left_s = kPassivityRecoveryWindow_s;
   state.force_sent_last_device_n.setZero();
   state.force_acting_device_n.setZero();

@@ -18,6 +18,16 @@
 namespace fissure::rt {
 namespace {
 
+/// A gap between two device samples longer than this [s] — the rt thread stalled (descheduled,
+/// a blocked exchange) while the device kept the last command — breaks the motion history like
+/// a device fault: the velocity filter restarts, and the passivity observer restarts its Δp chain
+/// and opens a recovery window (passivity.hpp). 10 ms is ten periods at 1 kHz: the wall was a
+/// sampled spring held ten times longer than the loop is built for, and the motion across the
+/// gap, paired with the one force that acted during it, says nothing about the contact's
+/// energy at the loop's rate (a 100 ms stall while the hand presses in left the controller
+/// owing a millijoule it could not take back at a hold: the wall held at 84 %).
+constexpr double kHistoryBreakGap_s = 0.01;
+
 // Read device → encoder → angles → FK → velocity. Returns the device fault bits of this
 // tick (0: p_device_m / v_device_m_per_s hold a good sample).
 std::uint32_t read_device(const RtModel& model, RtData& data, falcon::HapticDevice& device, TimeNs now_ns) noexcept {
@@ -114,10 +124,14 @@ TickResult tick(const RtModel& model, RtData& data, TickIo& io, const TickTiming
   const TimeNs now_ns = timing.now_ns;
   std::uint32_t flags = 0;
 
-  // 1. read device … velocity
+  // 1. read device … velocity (after a stall the history restarts: kHistoryBreakGap_s)
+  const bool history_break =
+      data.joints.have_reference && to_seconds(now_ns - data.last_judged_sample_ns) > kHistoryBreakGap_s;
+  if (history_break) data.velocity.primed = false;
   const std::uint32_t sample_faults = read_device(model, data, io.device, now_ns);
   data.have_position = sample_faults == 0;
   update_position_epoch(data, sample_faults);
+  if (history_break && data.have_position) restart_observer(data.passivity);
   if (data.have_position) observe_energy(data.passivity, data.p_device_m);
   update_device_faults(model, data, sample_faults);
 
