@@ -68,10 +68,6 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
   const double raw_force_n = force_device_n.norm();
   const double clamp_share = raw_force_n > config.max_force_n ? config.max_force_n / raw_force_n : 1.0;
   const double stored_j = std::max(0.0, stored_energy_j) * clamp_share * (2.0 - clamp_share);
-  if (state.forgive_stored_energy) {
-    state.recovery_forgiven_j += stored_j;
-    state.forgive_stored_energy = false;
-  }
   // Forgiven work already dissipated is no longer owed (see forgiven_j): not beyond the debt.
   state.recovery_forgiven_j =
       std::min(state.recovery_forgiven_j, std::max(0.0, state.energy_j + stored_j + config.margin_j));
@@ -221,7 +217,6 @@ void record_sent_force(PassivityState& state, const Eigen::Vector3d& force_devic
 void restart_observer(PassivityState& state) noexcept {
   close_recovery_window(state);  // a fault inside a window: that window's account closes here
   state.primed = false;
-  state.forgive_stored_energy = true;
   state.recovery_window_left_s = kPassivityRecoveryWindow_s;
   state.force_sent_last_device_n.setZero();
   state.force_acting_device_n.setZero();

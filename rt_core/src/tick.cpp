@@ -24,8 +24,7 @@ namespace {
 /// and opens a recovery window (passivity.hpp). 10 ms is ten periods at 1 kHz: the wall was a
 /// sampled spring held ten times longer than the loop is built for, and the motion across the
 /// gap, paired with the one force that acted during it, says nothing about the contact's
-/// energy at the loop's rate (a 100 ms stall while the hand presses in left the controller
-/// owing a millijoule it could not take back at a hold: the wall held at 84 %).
+/// energy at the loop's rate.
 constexpr double kHistoryBreakGap_s = 0.01;
 
 // Read device → encoder → angles → FK → velocity. Returns the device fault bits of this

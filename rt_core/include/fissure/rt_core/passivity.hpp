@@ -203,9 +203,6 @@ struct PassivityState {
   double recovery_window_left_s = 0.0;
   double recovery_window_energy_j = 0.0;  ///< work done in the current recovery window
   double recovery_forgiven_j = 0.0;       ///< Σ over closed windows of min(window work, forgiveness)
-  /// Set by restart_observer: the next controller tick forgives what the contact stores then
-  /// (see restart_observer).
-  bool forgive_stored_energy = false;
   /// Σ b·|v_f|²·T, never more than the debt E + U (nor kPassivityMaxDampingCredit_j): the
   /// device's dissipation g counts against the debt [J]
   double damping_credit_j = 0.0;
@@ -240,12 +237,7 @@ void record_sent_force(PassivityState& state, const Eigen::Vector3d& force_devic
 /// (the energy total is kept), drop the correction (the force restarts from zero via
 /// safety's ramp-in anyway) and open a kPassivityRecoveryWindow_s window whose work is
 /// reported separately (recovery_energy_j). The damper β acts on the whole E; the reduction g
-/// on E less up to kPassivityRecoveryForgiveness_j of each window's work, and less what the
-/// contact stores at the first controller tick after the restart (never more than the debt):
-/// the loop did not see the motion that loaded it — after a stall the hand may have pressed
-/// millimetres deeper under the last command, and the wall then pushes it back out with energy
-/// no observed work paid for. (After a device fault safety's ramp-in starts the force, and with
-/// it U, from zero.)
+/// on E less up to kPassivityRecoveryForgiveness_j of each window's work.
 void restart_observer(PassivityState& state) noexcept;
 
 }  // namespace fissure::rt
