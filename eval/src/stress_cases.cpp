@@ -1,6 +1,7 @@
 #include "fissure/eval/stress_cases.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -406,6 +407,47 @@ void add_geometry_cases(std::vector<StressCase>& cases) {
                    }});
 }
 
+/// Rests in contact: legs at kStallLegSpeed_m_per_s to random points pressed into the ball, each
+/// held kStallHold_s, with a kStallLength_s rt stall ending kStallBeforeArrival_s − kStallLength_s
+/// before the hand arrives — the hand keeps pressing in while the loop is stalled (SimFalcon
+/// integrates the gap: millimetres of motion the observer then pairs with one force), then rests
+/// through the recovery and the check window (kStressStallRecovery_s + kStressStallCheck_s).
+constexpr double kStallHold_s = 1.2;
+constexpr double kStallBeforeArrival_s = 0.15;
+constexpr double kStallLength_s = 0.1;
+constexpr double kStallLegSpeed_m_per_s = 0.1;
+/// Where the resting hand presses in: 4–16 mm into the ball's top (y < −0.02 presses in), within
+/// ±15 mm of its axis.
+const Eigen::Vector3d kRestCentre_device_m{0.0, -0.03, 0.11};
+const Eigen::Vector3d kRestHalf_device_m{0.015, 0.006, 0.015};
+
+void resting_hand_with_stalls(StressSetup& s, std::uint64_t seed) {
+  Rng rng(seed);
+  HandScript hand = s.scene.hand;
+  hand.waypoints.clear();
+  hand.button_events.clear();
+  Eigen::Vector3d at = as_eigen(hand.start_position_device_m);
+  double t_s = 0.0;
+  s.rt_stalls.clear();
+  while (t_s < s.duration_s + 1.0) {
+    const Eigen::Vector3d to = random_point(rng, kRestCentre_device_m, kRestHalf_device_m);
+    t_s += (to - at).norm() / kStallLegSpeed_m_per_s;
+    const double stall_s = t_s - kStallBeforeArrival_s;
+    if (stall_s > kFirstFault_s && stall_s + kStallLength_s + kStressRecoveryBound_s < s.duration_s) {
+      s.rt_stalls.push_back({stall_s, stall_s + kStallLength_s});
+    }
+    t_s += kStallHold_s;
+    add_leg(hand, to, kStallLegSpeed_m_per_s, kStallHold_s);
+    at = to;
+  }
+  s.device.hand = hand;
+  s.fault_windows = s.rt_stalls;
+  s.injected_events = s.rt_stalls.size();
+  // The host waits with the stalled rt thread (lockstep), so the proxy is one stall old when the
+  // loop resumes: the staleness fade acts until the next proxy arrives.
+  s.allowed_faults = rt::kFaultProxyStale;
+}
+
 void add_transport_cases(std::vector<StressCase>& cases) {
   const std::string g = "transport";
   struct Kind {
@@ -529,6 +571,7 @@ class Checker {
     }
     row_.proxies_rejected = s.proxies_rejected;
     check_recovery(s, t_s);
+    check_after_stall(s, t_s);
   }
 
   void host(const HostStatus& status, double t_s) {
@@ -558,6 +601,14 @@ class Checker {
   }
 
   void finish(double end_s) {
+    if (!setup_.rt_stalls.empty()) {
+      char what[200];
+      std::snprintf(what, sizeof what, "after %zu rt stalls: |F_cmd - F_contact|/|F_contact| max %.4f over %llu checked ticks",
+                    setup_.rt_stalls.size(), row_.stall_force_error_max,
+                    static_cast<unsigned long long>(row_.stall_checked_ticks));
+      row_.note += (row_.note.empty() ? "" : "; ") + std::string(what);
+      if (row_.stall_checked_ticks == 0) fail("rt stall: no tick in contact was checked after a stall", end_s);
+    }
     if (next_window_ < setup_.fault_windows.size()) {
       fail("recovery: not healthy again after the last injected fault", end_s);
     }
@@ -598,9 +649,54 @@ class Checker {
     (void)period_s_;
   }
 
+  // From kStressStallRecovery_s after a stall, for kStressStallCheck_s: the commanded force
+  // within kStressStallForceTolerance of the contact force (where that is ≥ kStressStallMinForce_n),
+  // both as their means over the last kStressStallMeanWindow_s (stress_cases.hpp says why).
+  void check_after_stall(const rt::TelemetrySample& s, double t_s) {
+    while (next_stall_ < setup_.rt_stalls.size() &&
+           t_s >= setup_.rt_stalls[next_stall_].end_s + kStressStallRecovery_s + kStressStallCheck_s) {
+      ++next_stall_;
+    }
+    if (next_stall_ >= setup_.rt_stalls.size()) return;
+    const double window_start_s = setup_.rt_stalls[next_stall_].end_s + kStressStallRecovery_s;
+    if (t_s < window_start_s - kStressStallMeanWindow_s) {
+      mean_samples_ = 0;
+      return;
+    }
+    const auto window_ticks = static_cast<std::size_t>(std::lround(kStressStallMeanWindow_s / period_s_));
+    const std::size_t slot = mean_samples_++ % kMeanRingSize;
+    commanded_ring_[slot] = as_eigen(s.force_device_n);
+    contact_ring_[slot] = as_eigen(s.contact_force_device_n);
+    if (t_s < window_start_s || mean_samples_ < window_ticks) return;
+    Eigen::Vector3d commanded = Eigen::Vector3d::Zero(), contact = Eigen::Vector3d::Zero();
+    for (std::size_t k = 0; k < window_ticks; ++k) {
+      const std::size_t i = (mean_samples_ - 1 - k) % kMeanRingSize;
+      commanded += commanded_ring_[i];
+      contact += contact_ring_[i];
+    }
+    commanded /= static_cast<double>(window_ticks);
+    contact /= static_cast<double>(window_ticks);
+    const double contact_n = contact.norm();
+    if (!(contact_n >= kStressStallMinForce_n)) return;
+    const double error = (commanded - contact).norm() / contact_n;
+    ++row_.stall_checked_ticks;
+    row_.stall_force_error_max = std::max(row_.stall_force_error_max, error);
+    if (error > kStressStallForceTolerance) {
+      fail("rt stall: commanded force not within 5 % of the contact force 200 ms after the stall", t_s);
+    }
+  }
+
+  /// Ring of the last commanded and contact forces for check_after_stall's means (≥ the window's
+  /// ticks at the fastest rate, 10 kHz × kStressStallMeanWindow_s).
+  static constexpr std::size_t kMeanRingSize = 256;
+  std::array<Eigen::Vector3d, kMeanRingSize> commanded_ring_{};
+  std::array<Eigen::Vector3d, kMeanRingSize> contact_ring_{};
+  std::size_t mean_samples_ = 0;
+
   StressRow& row_;
   const StressSetup& setup_;
   double period_s_;
+  std::size_t next_stall_ = 0;
   std::vector<std::string> failed_kinds_;
   std::uint32_t previous_faults_ = 0;
   std::size_t next_window_ = 0;
@@ -668,8 +764,13 @@ void run_setup(StressSetup& setup, StressRow& row) {
   DeviceState state{};
   ContactProxy proxy{};
   bool transport_clean = false;
+  std::size_t next_stall = 0;
   while (clock.now() < end_ns) {
     for (std::uint64_t k = 0; k < ticks_per_host; ++k) {
+      if (next_stall < setup.rt_stalls.size() && to_seconds(clock.now()) >= setup.rt_stalls[next_stall].start_s) {
+        const TimeWindow& stall = setup.rt_stalls[next_stall++];
+        clock.advance(static_cast<TimeNs>(std::llround((stall.end_s - stall.start_s) * 1e9)));
+      }
       loop.step();
       if (setup.transport) {
         rt_bridge->pump_rt(rx.state, rx.proxy);
@@ -747,6 +848,7 @@ std::vector<StressCase> stress_cases() {
   add_parameter_cases(cases);
   add_geometry_cases(cases);
   add_transport_cases(cases);
+  cases.push_back({"rt_stall_100ms_resting_hand", "device input", "spatula-sphere", 1000.0, resting_hand_with_stalls});
   // Failures found by this harness in other modules (base seed 7, ci profile) are listed here
   // by name with the module and reason: the ci profile then reports them as KNOWN instead of
   // failing; the full profile always fails on them. The list is empty: every failure the

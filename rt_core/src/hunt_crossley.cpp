@@ -24,7 +24,7 @@ double hunt_crossley_force_n(double x, double x_dot, double k, double lambda, do
 }
 
 ContactEvaluation evaluate_proxy(const ContactProxy& proxy, const DeviceMapping& mapping, const ToolState& tool,
-                                 PartForces& forces) noexcept {
+                                 PartForces& forces, const DampingCap& cap) noexcept {
   forces.clear();
   ContactEvaluation evaluation;
   evaluation.max_penetration_m = -1.0;  // "no patch": any real penetration is larger
@@ -39,9 +39,15 @@ ContactEvaluation evaluate_proxy(const ContactProxy& proxy, const DeviceMapping&
     evaluation.max_penetration_m = std::max(evaluation.max_penetration_m, x);
     if (!(x > 0.0)) continue;
     const double x_dot = -motion.v_world_m_per_s.dot(normal);
-    const double magnitude =
-        hunt_crossley_force_n(x, x_dot, patch.stiffness_k, patch.damping_lambda, patch.exponent_n);
-    forces.force_world_n[part_index] += magnitude * normal;
+    const double k = patch.stiffness_k;
+    const double n = patch.exponent_n;
+    const double x_n = power(x, n);
+    // Colgate–Schenkel (header): the damping λ·xⁿ at most b − n·k·xⁿ⁻¹·T/2, as a λ for this x.
+    const double tangent_stiffness = n * k * x_n / x;
+    const double max_damping = std::max(0.0, cap.device_damping_world_n_s_per_m - 0.5 * tangent_stiffness * cap.period_s);
+    const double lambda = std::min(patch.damping_lambda, max_damping / x_n);
+    forces.force_world_n[part_index] += std::max(0.0, k * x_n + lambda * x_n * x_dot) * normal;
+    evaluation.stored_energy_world_j += k * x_n * x / (n + 1.0);
     ++evaluation.patches_in_contact;
   }
   return evaluation;

@@ -54,15 +54,23 @@ void observe_energy(PassivityState& state, const Eigen::Vector3d& p_device_m) no
 
 Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState& state,
                                   const Eigen::Vector3d& force_device_n, const Eigen::Vector3d& v_filtered_m_per_s,
-                                  const Eigen::Vector3d& v_raw_m_per_s, double period_s) noexcept {
+                                  const Eigen::Vector3d& v_raw_m_per_s, double period_s,
+                                  double stored_energy_j) noexcept {
   state.damping_n_s_per_m = 0.0;
   state.energy_bound_acted = false;
   if (state.recovery_window_left_s > 0.0) {
     state.recovery_window_left_s = std::max(0.0, state.recovery_window_left_s - period_s);
     if (state.recovery_window_left_s <= 0.0) close_recovery_window(state);
   }
-  // Forgiven work already dissipated is no longer owed (see forgiven_j).
-  state.recovery_forgiven_j = std::min(state.recovery_forgiven_j, std::max(0.0, state.energy_j + config.margin_j));
+  // U as the rendered spring stores it: past max_force_n the force is clamped, and a spring
+  // clamped at the fraction r = F_max/|F| of its force stores r·(2 − r) of U (exact for n = 1, a
+  // slight underestimate for n > 1).
+  const double raw_force_n = force_device_n.norm();
+  const double clamp_share = raw_force_n > config.max_force_n ? config.max_force_n / raw_force_n : 1.0;
+  const double stored_j = std::max(0.0, stored_energy_j) * clamp_share * (2.0 - clamp_share);
+  // Forgiven work already dissipated is no longer owed (see forgiven_j): not beyond the debt.
+  state.recovery_forgiven_j =
+      std::min(state.recovery_forgiven_j, std::max(0.0, state.energy_j + stored_j + config.margin_j));
   if (!config.enabled) {
     state.reduction_fraction = 0.0;
     state.reduction_n = 0.0;
@@ -78,6 +86,28 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
   const Eigen::Vector3d force_direction = force_n > 0.0 ? Eigen::Vector3d(force / force_n) : Eigen::Vector3d::Zero();
   const double budget_j = kPassivityRampEnergyBudgetMargins * config.margin_j;
 
+  // The reduction g's debt: what the environment would have put into the hand once it has
+  // returned everything it stores now, E + U (passivity.hpp: the reference follows the stored
+  // energy), less the forgiven recovery work and what the device's own damper has dissipated,
+  // measured against the reference −margin.
+  const double debt_j = state.energy_j + stored_j - forgiven_j(state, config.margin_j + stored_j);
+  state.damping_credit_j += config.device_damping_n_s_per_m * v_filtered_m_per_s.squaredNorm() * period_s;
+  state.damping_credit_j = std::min(state.damping_credit_j, kPassivityMaxDampingCredit_j);
+  // In contact the damper's dissipation is banked for this contact's debt; out of it only what
+  // is still owed is kept (free motion does not pre-pay the next contact).
+  if (force_device_n.isZero(0.0)) state.damping_credit_j = std::min(state.damping_credit_j, std::max(0.0, debt_j + config.margin_j));
+  const double debt_excess_j = debt_j - state.damping_credit_j + config.margin_j;
+  // The same debt if g stays as it is: the rendered spring is (1 − g) of the environment's and
+  // stores (1 − g)·U, so a contact pressed with g in effect owes nothing for the part withheld.
+  const double kept_debt_excess_j = debt_excess_j - state.reduction_fraction * stored_j;
+  // While that debt is above the reference g holds (giving the force back while the hand pushes
+  // in would store energy the environment returns later; at standstill nothing is paid back)
+  // and grows while the environment returns energy (below); once it is paid — by g, by β, or by
+  // the device's own damper — g gives the force back, at a hold too: nothing is owed there
+  // (what the full force then stores is owed, and withheld, on the way out).
+  double target = kept_debt_excess_j > 0.0 ? state.reduction_fraction : 0.0;
+  double raise_step_n = config.max_correction_step_n;
+
   if (speed >= config.min_speed_m_per_s) {
     // Energy by the end of the interval this force acts in: what is observed, plus the
     // command already sent (acting now), plus this one. Of the two velocity estimates take
@@ -86,41 +116,34 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
     // so its noise cannot reach the force as a step.)
     const Eigen::Vector3d total = state.force_sent_last_device_n + force;
     // The damper acts on all of E; the reduction g on E less the forgiven recovery work
-    // (kPassivityRecoveryForgiveness_j per fault: a force brought back at a static hold).
+    // (kPassivityRecoveryForgiveness_j per fault: a force brought back at a static hold) and
+    // less the device damper's credit.
     const double predicted_all_j =
         state.energy_j + std::max(total.dot(v_filtered_m_per_s), total.dot(v_raw_m_per_s)) * period_s;
     const double excess_all_j = predicted_all_j + config.margin_j;
-    const double predicted_j = predicted_all_j - forgiven_j(state, config.margin_j);
-    const double excess_j = predicted_j + config.margin_j;  // above the reference −margin
+    const double predicted_j = predicted_all_j - forgiven_j(state, config.margin_j) - state.damping_credit_j;
 
     // g: while the environment returns energy (F̂·v > 0 by the raw difference, which has no
     // filter lag: gated by the lagging filtered velocity the reduction landed in the next
-    // inward half-cycle and pumped the contact resonance) and E' is above the reference, head
-    // for the fraction of F that dissipates the excess within dissipation_time_s. While E'
-    // stays above the reference and the hand pushes in, hold it (giving the force back now
-    // would store energy the environment will return); below the reference give it back.
+    // inward half-cycle and pumped the contact resonance) and its debt E + U is above the
+    // reference, head for the fraction of F that withholds the debt within dissipation_time_s.
     const double returning_m_per_s = force_direction.dot(v_raw_m_per_s);  // F̂·v
     // Power the force returns by the filtered velocity (quantisation-free: ≈ 0 at a hold).
     const double returned_power_w = std::max(0.0, force_direction.dot(v_filtered_m_per_s)) * force_n;
-    double target = 0.0;
-    if (excess_j > 0.0) {
-      if (returning_m_per_s > 0.0 && force_n > 0.0) {
-        // Withhold the excess from what the force returns over dissipation_time_s (a wall
-        // giving back slightly more than it stored)…
-        const double share_for_excess = excess_j / (config.dissipation_time_s * returning_m_per_s * force_n);
-        // …unless the loop has already generated more than the ramp's energy budget: then
-        // the environment is plainly active (a swap offset left from a contact the host has
-        // lost, pushing the hand out at watts) and the push comes off entirely, ramped. Only
-        // withholding the excess, g caught up with a force that keeps pushing at the rate the
-        // excess grew: an overshoot of P·dissipation_time_s (0.2 J at 4 W: the
-        // hc_lambda_over_k_0 stress case, 0.115 J).
-        const double share = predicted_j > budget_j ? 1.0 : share_for_excess;
-        target = std::max(state.reduction_fraction, std::min(1.0, share));
-      } else {
-        target = state.reduction_fraction;
-      }
+    if (debt_excess_j > 0.0 && returning_m_per_s > 0.0 && force_n > 0.0) {
+      // Withhold the debt from what the force returns over dissipation_time_s (a wall
+      // giving back slightly more than it stored)…
+      const double share_for_excess = debt_excess_j / (config.dissipation_time_s * returning_m_per_s * force_n);
+      // …unless the loop has already generated more than the ramp's energy budget: then
+      // the environment is plainly active (a swap offset left from a contact the host has
+      // lost, pushing the hand out at watts) and the push comes off entirely, ramped. Only
+      // withholding the excess, g caught up with a force that keeps pushing at the rate the
+      // excess grew: an overshoot of P·dissipation_time_s (0.2 J at 4 W: the
+      // hc_lambda_over_k_0 stress case, 0.115 J).
+      const double share = predicted_j > budget_j ? 1.0 : share_for_excess;
+      target = std::max(state.reduction_fraction, std::min(1.0, share));
     }
-    // The fraction may change by at most max_correction_step_n of force per tick, steeper in
+    // The fraction may grow by at most max_correction_step_n of force per tick, steeper in
     // proportion to how much energy has really been created (E' > 0).
     const double urgency =
         std::min(kPassivityMaxUrgency, 1.0 + std::max(0.0, predicted_j) / (kPassivityUrgencyMargins * config.margin_j));
@@ -128,16 +151,15 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
     // P = F̂·v_f·|F|, taking it off at s newtons per tick returns about ½·P·T·|F|/s before it
     // is gone; s is at least what keeps that within the budget (kPassivityRampEnergyBudgetMargins
     // margins). At a hold (v_f of mm/s, a few N) this is far below max_correction_step_n and
-    // changes nothing; a force pushing a hand out at
-    // 0.5 m/s with 8 N (a flick bouncing off the contact, a swap offset left from a contact the
-    // host has already lost) is taken off within a few ticks instead of at 0.05–2 N per tick
-    // while it delivers 4 mJ per tick (hc_lambda_over_k_0 stress case: 0.115 J).
-    // (|F| and P of the whole force, not of the part still acting: a step sized to the
-    // remainder shrinks as it goes and the tail returns the budget again and again.)
-    const double energy_bounded_step_n = excess_j > 0.0 ? returned_power_w * period_s * force_n / (2.0 * budget_j) : 0.0;
-    const double step_n = std::max(config.max_correction_step_n * urgency, energy_bounded_step_n);
-    const double max_fraction_step = std::min(1.0, step_n / std::max(force_n, config.max_correction_step_n));
-    state.reduction_fraction = slew(state.reduction_fraction, target, max_fraction_step);
+    // changes nothing; a force pushing a hand out at 0.5 m/s with 8 N (a flick bouncing off the
+    // contact, a swap offset left from a contact the host has already lost) is taken off within
+    // a few ticks instead of at 0.05–2 N per tick while it delivers 4 mJ per tick
+    // (hc_lambda_over_k_0 stress case: 0.115 J). (|F| and P of the whole force, not of the part
+    // still acting: a step sized to the remainder shrinks as it goes and the tail returns the
+    // budget again and again.)
+    const double energy_bounded_step_n =
+        debt_excess_j > 0.0 ? returned_power_w * period_s * force_n / (2.0 * budget_j) : 0.0;
+    raise_step_n = std::max(config.max_correction_step_n * urgency, energy_bounded_step_n);
 
     // β: the damping that dissipates the excess within dissipation_time_s at this speed,
     // bounded, ramped.
@@ -150,10 +172,11 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
                                     : config.max_damping_n_s_per_m;
     state.added_damping_n_s_per_m = slew(state.added_damping_n_s_per_m, damping_target, damping_step);
   }
-  // At (filtered) standstill g and β hold: the force does no work there, and giving it back
-  // between the swings of a buzzing contact (still on average) undid the controller — with a
-  // give-back at a tenth of the base ramp the Z-width with the controller on fell below the
-  // uncontrolled one (a 1–3 mm slow limit cycle at 2–8 kHz, fissure bench rt).
+  // g gives the force back at the base ramp (no click), and takes it off at the raise step.
+  const double step_n = target > state.reduction_fraction ? raise_step_n : config.max_correction_step_n;
+  const double max_fraction_step = std::min(1.0, step_n / std::max(force_n, config.max_correction_step_n));
+  state.reduction_fraction = slew(state.reduction_fraction, target, max_fraction_step);
+  // At (filtered) standstill β holds: the force does no work there.
 
   // Energy bounding at speed (passivity.hpp): the part of F along the motion may return at most
   // what is left of the budget once E and the command already sent (acting over the next

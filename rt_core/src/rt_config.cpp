@@ -1,6 +1,7 @@
 #include "fissure/rt_core/rt_config.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include "fissure/shared/device_mapping.hpp"
 
@@ -59,6 +60,7 @@ const char* check_config(const RtConfig& c) noexcept {
   }
   if (!positive(c.faults.max_joint_rate_rad_per_s)) return "faults.max_joint_rate_rad_per_s must be > 0";
   if (c.faults.recovery_ticks < 0) return "faults.recovery_ticks must be ≥ 0";
+  if (!non_negative(c.passivity.device_damping_n_s_per_m)) return "passivity.device_damping_n_s_per_m must be ≥ 0";
   return nullptr;
 }
 
@@ -71,6 +73,14 @@ bool build_model(const RtConfig& config, RtModel& model, const char** error) noe
   model.period_s = to_seconds(model.period_ns);
   model.velocity_filter = design_velocity_filter(config.velocity.cutoff_hz, config.rate_hz);
   model.velocity_lag_s = velocity_lag_s(config.velocity.cutoff_hz, config.rate_hz);
+  // F_device = force_scale·F_world and Δp_world = scale·Δp_device: a world damping B renders
+  // force_scale·scale·B at the device, so the device's b is b / (force_scale·scale) in the world.
+  const double world_per_device_damping = config.mapping.force_scale * config.mapping.scale;
+  model.damping_cap.device_damping_world_n_s_per_m = world_per_device_damping > 0.0
+                                                         ? config.passivity.device_damping_n_s_per_m / world_per_device_damping
+                                                         : std::numeric_limits<double>::infinity();
+  model.damping_cap.period_s = model.period_s;
+  model.device_energy_per_world_energy = config.mapping.force_scale / config.mapping.scale;
   return true;
 }
 

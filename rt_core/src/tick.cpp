@@ -18,6 +18,15 @@
 namespace fissure::rt {
 namespace {
 
+/// A gap between two device samples longer than this [s] — the rt thread stalled (descheduled,
+/// a blocked exchange) while the device kept the last command — breaks the motion history like
+/// a device fault: the velocity filter restarts, and the passivity observer restarts its Δp chain
+/// and opens a recovery window (passivity.hpp). 10 ms is ten periods at 1 kHz: the wall was a
+/// sampled spring held ten times longer than the loop is built for, and the motion across the
+/// gap, paired with the one force that acted during it, says nothing about the contact's
+/// energy at the loop's rate.
+constexpr double kHistoryBreakGap_s = 0.01;
+
 // Read device → encoder → angles → FK → velocity. Returns the device fault bits of this
 // tick (0: p_device_m / v_device_m_per_s hold a good sample).
 std::uint32_t read_device(const RtModel& model, RtData& data, falcon::HapticDevice& device, TimeNs now_ns) noexcept {
@@ -114,10 +123,14 @@ TickResult tick(const RtModel& model, RtData& data, TickIo& io, const TickTiming
   const TimeNs now_ns = timing.now_ns;
   std::uint32_t flags = 0;
 
-  // 1. read device … velocity
+  // 1. read device … velocity (after a stall the history restarts: kHistoryBreakGap_s)
+  const bool history_break =
+      data.joints.have_reference && to_seconds(now_ns - data.last_judged_sample_ns) > kHistoryBreakGap_s;
+  if (history_break) data.velocity.primed = false;
   const std::uint32_t sample_faults = read_device(model, data, io.device, now_ns);
   data.have_position = sample_faults == 0;
   update_position_epoch(data, sample_faults);
+  if (history_break && data.have_position) restart_observer(data.passivity);
   if (data.have_position) observe_energy(data.passivity, data.p_device_m);
   update_device_faults(model, data, sample_faults);
 
@@ -137,17 +150,21 @@ TickResult tick(const RtModel& model, RtData& data, TickIo& io, const TickTiming
     Eigen::Vector3d new_force = Eigen::Vector3d::Zero();
     data.max_penetration_m = -1.0;
     data.patches_in_contact = 0;
+    double stored_energy_j = 0.0;
     if (data.proxy.have_proxy) {
       const ContactEvaluation evaluation =
-          evaluate_proxy(active_proxy(data.proxy), config.mapping, data.tool, data.part_forces);
+          evaluate_proxy(active_proxy(data.proxy), config.mapping, data.tool, data.part_forces, model.damping_cap);
       data.max_penetration_m = evaluation.max_penetration_m;
       data.patches_in_contact = evaluation.patches_in_contact;
       new_force = part_forces_to_device(config.mapping, data.part_forces);
+      // The staleness fade and safety's ramp scale the rendered spring, and with it what it stores.
+      stored_energy_j = fade_gain * data.safety.ramp_gain * model.device_energy_per_world_energy *
+                        evaluation.stored_energy_world_j;
     }
     if (intake == ProxyIntake::kAccepted) {
       Eigen::Vector3d old_force = Eigen::Vector3d::Zero();  // the first proxy blends in from zero
       if (data.proxy.have_previous) {
-        evaluate_proxy(previous_proxy(data.proxy), config.mapping, data.tool, data.part_forces);
+        evaluate_proxy(previous_proxy(data.proxy), config.mapping, data.tool, data.part_forces, model.damping_cap);
         old_force = part_forces_to_device(config.mapping, data.part_forces);
       }
       begin_swap(data.blend, old_force, new_force);
@@ -166,7 +183,7 @@ TickResult tick(const RtModel& model, RtData& data, TickIo& io, const TickTiming
     const Eigen::Vector3d environment_device_n =
         data.contact_force_device_n + workspace_soft_wall_n(config.safety, data.p_device_m, flags);
     force = passivity_control(config.passivity, data.passivity, environment_device_n, data.v_device_m_per_s,
-                              data.velocity.x1, model.period_s);
+                              data.velocity.x1, model.period_s, stored_energy_j);
     if ((data.passivity.damping_n_s_per_m) > 0.0) flags |= kFlagPassivityActive;
   } else {
     data.contact_force_device_n.setZero();

@@ -81,5 +81,33 @@ TEST(HuntCrossley, PatchesSumPerToolPart) {
   EXPECT_NEAR((forces.force_world_n[2] - Eigen::Vector3d(0.0, 1.0, 0.0)).norm(), 0.0, 1e-12);
 }
 
+// Colgate–Schenkel: a patch renders damping λ·xⁿ only up to b − n·k·xⁿ⁻¹·T/2 (the device's
+// damping b less what the sampled stiffness already needs of it); the elastic part is untouched.
+TEST(HuntCrossley, CapsTheRenderedDampingAtWhatTheDeviceCanDissipate) {
+  DeviceMapping identity;
+  ToolState tool;
+  tool.p_tool_world_m = Eigen::Vector3d(0.0, -0.004, 0.0);      // x = 4 mm
+  tool.v_tool_world_m_per_s = Eigen::Vector3d(0.0, -0.1, 0.0);  // ẋ = +0.1 m/s
+  PartForces forces;
+  const DampingCap cap{3.0, 1e-3};  // SimFalcon's nominal b, 1 kHz
+  const double k = 2000.0, n = 1.5, x = 0.004, x_n = std::pow(x, n);
+  const double max_damping = 3.0 - 0.5 * n * k * std::pow(x, n - 1.0) * 1e-3;  // 2.905 N·s/m
+  // λ·xⁿ = 50·2.5e-4 = 0.013 N·s/m: far below the cap, plain HC.
+  evaluate_proxy(wall_proxy(k, 50.0, n), identity, tool, forces, cap);
+  EXPECT_NEAR(forces.force_world_n[0].y(), k * x_n + 50.0 * x_n * 0.1, 1e-12);
+  // λ·xⁿ = 5e4·2.5e-4 = 12.6 N·s/m: capped at 2.905 N·s/m.
+  const ContactEvaluation evaluation = evaluate_proxy(wall_proxy(k, 5e4, n), identity, tool, forces, cap);
+  EXPECT_NEAR(forces.force_world_n[0].y(), k * x_n + max_damping * 0.1, 1e-12);
+  // The stored energy is the elastic part's: k·xⁿ⁺¹/(n+1).
+  EXPECT_NEAR(evaluation.stored_energy_world_j, k * std::pow(x, n + 1.0) / (n + 1.0), 1e-15);
+  // So stiff that K·T/2 alone exceeds b: no damping at all (the elastic force stays).
+  const double stiff_k = 1e5;  // tangent 1.5·1e5·0.063 = 9487 N/m: K·T/2 = 4.7 > 3
+  evaluate_proxy(wall_proxy(stiff_k, 5e4, n), identity, tool, forces, cap);
+  EXPECT_NEAR(forces.force_world_n[0].y(), stiff_k * x_n, 1e-9);
+  // Without a cap (the default, as the host evaluates the proxy) the damping is the proxy's.
+  evaluate_proxy(wall_proxy(k, 5e4, n), identity, tool, forces);
+  EXPECT_NEAR(forces.force_world_n[0].y(), k * x_n * (1.0 + 5e4 / k * 0.1), 1e-9);
+}
+
 }  // namespace
 }  // namespace fissure::rt

@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstdlib>
 #include <memory>
 #include <new>
@@ -196,6 +198,70 @@ TEST(RtLoop, TheSameStiffWallIsActiveWithoutThePassivityController) {
   // ≈ +0.19 mJ true, +0.29 mJ observed (the pressed spring stores ≈ 1.5 mJ at most).
   EXPECT_GT(off.truth_energy_j, 1e-4) << "observer said " << off.observed_energy_j;
   EXPECT_GT(off.observed_energy_j, 1e-4);
+}
+
+// Issue 26: a hand that hits a 3000 N/m wall (the Falcon's rated stiffness) at 0.5 m/s and then
+// rests against it, 8 mm past the surface through its 300 N/m grip (≈ 2.2 N), at 1 kHz. The
+// impact makes the sampled wall return a little more than it stored, so the observer's E
+// ends above a fixed reference −margin, and a reduction held while the hand rests would render
+// the wall near 0 N from then on. The reference follows the wall's stored energy, the device's
+// damper is credited with what it dissipated, and g gives the force back once that debt is
+// paid, so the hand gets the wall's force within 100 ms of the impact and keeps it.
+struct RestingHandResult {
+  double contact_s = -1.0;
+  double min_ratio_after_100ms = 1e9;  ///< commanded / wall force, from contact + 100 ms on
+  double wall_force_end_n = 0.0;
+  double max_correction_step_n = 0.0;  ///< largest per-tick change of commanded − wall force
+  double max_observed_energy_j = -1e9;
+};
+
+RestingHandResult run_resting_hand(bool passivity_on) {
+  constexpr double kWall_n_per_m = 3000.0, kWallY_m = -0.004;
+  RtConfig config;
+  config.passivity.enabled = passivity_on;
+  falcon::SimFalconConfig sim;
+  HandScript hand;
+  hand.start_position_device_m = {0.0, 0.002, kCentreZ_m};
+  hand.waypoints.push_back({{0.0, 0.002, kCentreZ_m}, 0.05, 0.6});  // wait out the ramp-in
+  hand.waypoints.push_back({{0.0, kWallY_m - 0.008, kCentreZ_m}, 0.5, 1.5});
+  hand.release_at_end = false;
+  sim.hand = hand;
+  Session s(config, sim);
+  RestingHandResult result;
+  TelemetrySample sample;
+  double last_correction_n = 0.0;
+  for (int k = 0; k < 1800; ++k) {
+    s.proxy_in.publish(plane_proxy(static_cast<std::uint64_t>(k + 1), {0.0, kWallY_m, 0.0}, {0.0, 1.0, 0.0}, kWall_n_per_m));
+    s.loop->step();
+    while (s.telemetry->try_pop(sample)) {
+      const double t_s = to_seconds(sample.time_ns);
+      const double wall_n = sample.contact_force_device_n[1];
+      const double commanded_n = sample.force_device_n[1];
+      if (result.contact_s < 0.0 && wall_n > 0.0) result.contact_s = t_s;
+      if (result.contact_s >= 0.0 && t_s >= result.contact_s + 0.1) {
+        result.min_ratio_after_100ms = std::min(result.min_ratio_after_100ms, commanded_n / wall_n);
+        result.max_correction_step_n =
+            std::max(result.max_correction_step_n, std::abs((commanded_n - wall_n) - last_correction_n));
+      }
+      last_correction_n = commanded_n - wall_n;
+      result.max_observed_energy_j = std::max(result.max_observed_energy_j, sample.energy_j);
+      result.wall_force_end_n = wall_n;
+    }
+  }
+  return result;
+}
+
+TEST(RtLoop, AHandRestingOnAStiffWallAfterAnImpactGetsTheWallsForceWithin100ms) {
+  const RestingHandResult on = run_resting_hand(true);
+  ASSERT_GT(on.contact_s, 0.6);
+  // The hand does rest on the wall: K·x against the grip spring, 8 mm past the surface.
+  EXPECT_NEAR(on.wall_force_end_n, 3000.0 * 300.0 * 0.008 / 3300.0, 0.1);
+  EXPECT_GE(on.min_ratio_after_100ms, 0.9);
+  // Without clicks: what the controller changes is a ramp (its base step 0.05 N per tick, the
+  // damper β·v_f, and the urgency factor), never the whole force.
+  EXPECT_LE(on.max_correction_step_n, 0.2);
+  // And the observer stays passive within the stress bound (25 mJ) — far within it.
+  EXPECT_LE(on.max_observed_energy_j, 0.005);
 }
 
 // A device whose exchange takes 2.5 periods of (lockstep) time.

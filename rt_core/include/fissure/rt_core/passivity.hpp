@@ -14,25 +14,35 @@
 //
 // Controller. Predicted energy at the end of the interval this tick's force acts in:
 //     E' = E + (F_sent + F)·v·T       (F_sent: the command already on its way)
+// The reduction's reference follows the energy the environment stores (Ryu, Preusche,
+// Hannaford & Hirzinger 2005: reference-energy following): with U = Σ k·xⁿ⁺¹/(n+1) over the
+// patches in contact (hunt_crossley.hpp), E + U is what the hand will have received once the
+// environment has returned everything it stores now — its debt. A passive spring pressed and
+// held has E = −U, debt 0; a sampled one hit hard returns a little more than it stored, and
+// that surplus is what the controller takes back, from the force while it returns energy.
+// (Against a fixed reference, E = −U + surplus sat above −margin while the hand rested on a
+// stiff wall after an impact, and a reduction held at standstill rendered the wall near 0 N.)
 // The correction it applies is smooth by construction — two rate-limited quantities:
 //   * r [N], a reduction of the environment force along the force's own direction:
 //         F_out = F − min(r, |F|)·F̂ − β·v_f
 //     F̂ is the contact normal (stable in contact), not v̂ (which flips with every encoder
 //     count at standstill), so the correction does not jump when the motion reverses.
-//     r heads for the amount that would bring E' back to the reference −margin in one tick
-//     while the environment is returning energy (F·v_f > 0) and E' > −margin; it heads for 0
-//     otherwise. Per tick r moves by at most
+//     r heads for the share of F that withholds the debt E + U (above the reference −margin)
+//     within dissipation_time_s while the environment is returning energy (F̂·v_raw > 0, v_f
+//     above min_speed); it heads back to 0 otherwise — at a hold or while the hand pushes in
+//     the force does no work, and what it stores is counted in U and owed on the way out.
+//     Per tick r grows by at most
 //         Δr_max = max_correction_rate_n_per_s · T · (1 + max(0, E')/margin)
 //     i.e. a ramp the hand does not feel as a click while the loop is nearly passive (E' ≤
 //     0: 0.05 N per tick at 1 kHz, the same bound as a proxy swap), faster in proportion to
 //     how much energy has really been created (a loop far beyond its Z-width must be caught
-//     within a few ticks; at E' = 10·margin the ramp is 11× steeper).
+//     within a few ticks; at E' = 10·margin the ramp is 11× steeper), and falls by at most
+//     max_correction_step_n.
 //   * β [N·s/m], a damper on the filtered velocity v_f, ramped between 0 and
 //     max_damping_n_s_per_m over damping_ramp_s: full while E' > −margin, zero otherwise.
 //     v_f is continuous (2nd-order low-pass), so β·v_f has no steps either. β is bounded
-//     below the device's own damping: a virtual damper behind the ping-pong latency and the
-//     filter lag is itself subject to the sampled-data limit b > K·T/2 + |B| (Colgate &
-//     Schenkel 1997).
+//     (kDefaultPassivityMaxDamping_n_s_per_m says why it may exceed the device's b on v_f).
+//     β acts on all of E (not on the debt): it is what drains the energy the observer reports.
 // Energy bound on the ramp: while E' is above the reference and F pushes the hand
 // out at power P (filtered velocity), r heads for at least the share that lets the force
 // return no more than the rest of a 10-margin budget over dissipation_time_s, and moves by at
@@ -43,8 +53,8 @@
 // dissipation over many ticks instead of removing it all in the tick E crosses zero (the
 // chatter of the plain Hannaford–Ryu controller: a 2.3 N step per encoder count at a hold).
 // The cost is that E may overshoot 0 briefly; what the observer sees is still returned.
-// Below min_speed_m_per_s r and β hold their values: the direction of v_f is noise there, and
-// a force at standstill does no work.
+// Below min_speed_m_per_s β holds its value and r only gives back: the direction of v_f is
+// noise there, and a force at standstill does no work.
 //
 // The force the controller works on is the one the device can render: the environment force
 // clamped to max_force_n (safety's clamp, which comes after). Acting on the unclamped force,
@@ -130,13 +140,37 @@ inline constexpr double kPassivityRecoveryWindow_s = 0.3;
 /// contact rendered at a jumped, false position: 26 mJ in 80 ms) is taken off by g as usual.
 inline constexpr double kPassivityRecoveryForgiveness_j = 10.0 * kDefaultPassivityMargin_j;
 
+/// Largest credit for the device's own dissipation the reduction g may count against the debt
+/// [J]: what a wall at the Falcon's rated stiffness stores at its rated force, F²/(2K) =
+/// 8²/(2·3000) = 10.7 mJ — a contact's worth. The observer E itself never counts the credit,
+/// and β still acts on all of E, so the energy the stress harness bounds stays drained.
+inline constexpr double kPassivityMaxDampingCredit_j =
+    kFalconMaxForce_n * kFalconMaxForce_n / (2.0 * kFalconMaxStiffness_n_per_m);
+
+/// Largest damping β the controller adds [N·s/m]: 5 N·s/m, chosen by measurement (fissure bench
+/// rt and the rt_stall stress case, docs/decisions.md, issue 26). β acts on the filtered
+/// velocity v_f (2nd-order, 100 Hz at 1 kHz), whose gain near the Nyquist rate — where the
+/// sampled-data activity Colgate–Schenkel's b > K·T/2 + |B| is about lives — is a small fraction
+/// of its gain at the contact resonance (15–30 Hz with the hand), so β may exceed the device's b
+/// there without turning active: the bench's walls stay passive (device damper counted) at every
+/// rate. Lower holds the wall back: at 2 N·s/m a 3000 N/m wall at 1 kHz kept a 1 mm limit cycle
+/// (rendered at 56 % of its stiffness), at 4 N·s/m the next grid point after 2910 N/m (3638) buzzed.
+/// Higher distorts a hold: β·v_f against a contact the host makes buzz at ~60 Hz, ±15 mm/s, is
+/// 5.6 % of a 2 N force at 6 N·s/m (4.7 % at 5). Far below CHAI3D's 20 N·s/m Falcon limit (BRIEF §5).
+inline constexpr double kDefaultPassivityMaxDamping_n_s_per_m = 5.0;
+
 struct PassivityConfig {
   bool enabled = true;
-  /// Largest damping the controller may add [N·s/m]. Below SimFalcon's nominal mechanism
-  /// damping (3 N·s/m) so that, by Colgate–Schenkel, the added damper cannot itself become
-  /// active. (CHAI3D's 20 N·s/m Falcon limit is for a damper rendered with the hand's own
-  /// damping added; the controller cannot count on it.)
-  double max_damping_n_s_per_m = 2.0;
+  /// The device's own viscous damping b [N·s/m] (kFalconDeviceDamping_n_s_per_m, safety.hpp).
+  /// It dissipates b·|v|²·T per tick whatever the controller does: g counts that (up to
+  /// kPassivityMaxDampingCredit_j, on the filtered velocity, which underestimates |v|² of a
+  /// buzz) against the debt — the port the hand holds is the rendered environment plus this
+  /// damper, the port Colgate–Schenkel's b > K·T/2 + |B| is about. The rendered contact damping
+  /// is capped with it too (hunt_crossley.hpp). Set it to the device's value: a larger one than
+  /// the device has lets through energy and damping it cannot dissipate.
+  double device_damping_n_s_per_m = kFalconDeviceDamping_n_s_per_m;
+  /// Largest damping the controller may add [N·s/m]: kDefaultPassivityMaxDamping_n_s_per_m.
+  double max_damping_n_s_per_m = kDefaultPassivityMaxDamping_n_s_per_m;
   /// Below this filtered speed the controller holds its correction [m/s]: one encoder count
   /// per tick at 1 kHz reads ≈ 50 mm/s raw, ≲ 1 mm/s after the filter; the direction of v is
   /// noise below that and a force at standstill does no work anyway.
@@ -169,6 +203,9 @@ struct PassivityState {
   double recovery_window_left_s = 0.0;
   double recovery_window_energy_j = 0.0;  ///< work done in the current recovery window
   double recovery_forgiven_j = 0.0;       ///< Σ over closed windows of min(window work, forgiveness)
+  /// Σ b·|v_f|²·T, never more than the debt E + U (nor kPassivityMaxDampingCredit_j): the
+  /// device's dissipation g counts against the debt [J]
+  double damping_credit_j = 0.0;
   double reduction_fraction = 0.0;        ///< g: share of F taken off along F̂ [0, 1]
   double reduction_n = 0.0;               ///< r = g·|F| in the last tick [N]
   double added_damping_n_s_per_m = 0.0;   ///< β
@@ -186,9 +223,12 @@ void observe_energy(PassivityState& state, const Eigen::Vector3d& p_device_m) no
 /// Controller: returns the force with the passivity correction applied (unchanged when
 /// disabled or while the correction is zero). v_raw is used only to predict the energy (it
 /// leads the filtered estimate by ~3 ms); the force uses v_filtered alone.
+/// stored_energy_j: the energy the environment stores at this sample, U ≥ 0 [J] at the device
+/// port (the reference of the reduction g follows it: E + U is what the environment owes).
 Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState& state,
                                   const Eigen::Vector3d& force_device_n, const Eigen::Vector3d& v_filtered_m_per_s,
-                                  const Eigen::Vector3d& v_raw_m_per_s, double period_s) noexcept;
+                                  const Eigen::Vector3d& v_raw_m_per_s, double period_s,
+                                  double stored_energy_j = 0.0) noexcept;
 
 /// Records the force that actually went out this tick (after safety) for the observer.
 void record_sent_force(PassivityState& state, const Eigen::Vector3d& force_device_n) noexcept;

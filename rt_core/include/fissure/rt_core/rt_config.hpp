@@ -7,6 +7,7 @@
 #include "fissure/falcon_hw/falcon_geometry.hpp"
 #include "fissure/falcon_hw/kinematics.hpp"
 #include "fissure/falcon_hw/motor_command.hpp"
+#include "fissure/rt_core/hunt_crossley.hpp"
 #include "fissure/rt_core/joint_angles.hpp"
 #include "fissure/rt_core/passivity.hpp"
 #include "fissure/rt_core/safety.hpp"
@@ -52,6 +53,10 @@ struct RtModel {
   double period_s = 0.0;
   VelocityFilterCoefficients velocity_filter{};
   double velocity_lag_s = 0.0;  ///< documented lag of the velocity estimate at this rate
+  DampingCap damping_cap{};     ///< the device's damping in world units, and T (hunt_crossley.hpp)
+  /// Device-port joules per world joule of stored contact energy: F_device·Δp_device =
+  /// (force_scale / scale)·F_world·Δp_world (device_mapping.hpp).
+  double device_energy_per_world_energy = 1.0;
 };
 
 /// First problem in `config` as a static string naming the field ("rate_hz must be in

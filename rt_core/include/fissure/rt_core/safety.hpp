@@ -30,6 +30,11 @@ inline constexpr double kFalconMaxForce_n = 8.0;
 inline constexpr double kFalconMaxStiffness_n_per_m = 3000.0;
 /// CHAI3D's Falcon maxLinearDamping [N·s/m] (BRIEF §5).
 inline constexpr double kFalconMaxDamping_n_s_per_m = 20.0;
+/// The Falcon mechanism's viscous damping b [N·s/m] (motor back-EMF, capstan and joint friction
+/// lumped): nominal, "a few N·s/m" per the published identifications the issue-3 brief quotes,
+/// the same value as SimFalcon's kSimViscousDamping_n_s_per_m (falcon_hw/sim_falcon.hpp); not
+/// measured on a unit. The b of Colgate–Schenkel's b > K·T/2 + |B| that caps rendered damping.
+inline constexpr double kFalconDeviceDamping_n_s_per_m = 3.0;
 /// CHAI3D's Falcon workspace radius [m] (BRIEF §5). Inside falcon_hw's documented 5 cm
 /// well-conditioned ball and inside SimFalcon's 4.7 cm end stops, so the soft wall acts
 /// before the mechanism's limits do.
