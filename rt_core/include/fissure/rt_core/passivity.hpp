@@ -27,10 +27,13 @@
 //         F_out = F − min(r, |F|)·F̂ − β·v_f
 //     F̂ is the contact normal (stable in contact), not v̂ (which flips with every encoder
 //     count at standstill), so the correction does not jump when the motion reverses.
-//     r heads for the share of F that withholds the debt E + U (above the reference −margin)
-//     within dissipation_time_s while the environment is returning energy (F̂·v_raw > 0, v_f
-//     above min_speed); it heads back to 0 otherwise — at a hold or while the hand pushes in
-//     the force does no work, and what it stores is counted in U and owed on the way out.
+//     r heads for the share of F that withholds the debt E + U − C (above the reference
+//     −margin; C: the device damper's credit, PassivityConfig::device_damping_n_s_per_m) within
+//     dissipation_time_s while the environment is returning energy (F̂·v_raw > 0, v_f above
+//     min_speed). Otherwise it holds while the debt at the current reduction, E + (1 − g)·U − C
+//     (the rendered spring is (1 − g) of the environment's), is above the reference, and heads
+//     back to 0 once that is paid — at a hold too: the force does no work there, and what the
+//     full force then stores is counted in U and owed on the way out.
 //     Per tick r grows by at most
 //         Δr_max = max_correction_rate_n_per_s · T · (1 + max(0, E')/margin)
 //     i.e. a ramp the hand does not feel as a click while the loop is nearly passive (E' ≤
