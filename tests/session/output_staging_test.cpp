@@ -12,16 +12,13 @@
 #include <sstream>
 #include <string>
 
+#include "read_file.hpp"
+
 namespace fissure::session {
 namespace {
 namespace fs = std::filesystem;
 
-std::string read(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::read_file;
 
 void write(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
 
@@ -45,9 +42,9 @@ TEST_F(OutputStagingTest, AFileIsWrittenUnderAHiddenNameWithItsExtensionAndMoved
   EXPECT_EQ(tmp.filename().string().front(), '.');
   EXPECT_EQ(tmp.extension(), ".csv");
   write(tmp, "new complete trace\n");
-  EXPECT_EQ(read(dir_ / "trace.csv"), "old complete trace\n");
+  EXPECT_EQ(read_file(dir_ / "trace.csv"), "old complete trace\n");
   staging.commit();
-  EXPECT_EQ(read(dir_ / "trace.csv"), "new complete trace\n");
+  EXPECT_EQ(read_file(dir_ / "trace.csv"), "new complete trace\n");
   EXPECT_FALSE(fs::exists(tmp));
 }
 
@@ -58,7 +55,7 @@ TEST_F(OutputStagingTest, AnAbandonedRunLeavesTheEarlierFilesAsTheyWereAndNoTemp
     write(staging.file(dir_ / "trace.csv"), "half a ro");
     write(staging.file(dir_ / "summary.json"), "{");
   }
-  EXPECT_EQ(read(dir_ / "trace.csv"), "old\n");
+  EXPECT_EQ(read_file(dir_ / "trace.csv"), "old\n");
   EXPECT_FALSE(fs::exists(dir_ / "summary.json"));
   int entries = 0;
   for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir_)) ++entries;
@@ -70,7 +67,7 @@ TEST_F(OutputStagingTest, FilesStagedButNeverWrittenAreSkippedByCommit) {
   OutputStaging staging;
   (void)staging.file(dir_ / "session.png");  // the plotter failed: nothing written
   staging.commit();
-  EXPECT_EQ(read(dir_ / "session.png"), "old plot");
+  EXPECT_EQ(read_file(dir_ / "session.png"), "old plot");
 }
 
 TEST_F(OutputStagingTest, AStagedDirectoryReplacesTheOldFramesAndKeepsEveryOtherFile) {
@@ -82,12 +79,12 @@ TEST_F(OutputStagingTest, AStagedDirectoryReplacesTheOldFramesAndKeepsEveryOther
   const fs::path tmp = staging.directory(frames, "frame_", ".png");
   EXPECT_EQ(tmp.parent_path(), frames);
   for (int i = 0; i < 2; ++i) write(tmp / ("frame_00000" + std::to_string(i) + ".png"), "new");
-  EXPECT_EQ(read(frames / "frame_000004.png"), "old");
+  EXPECT_EQ(read_file(frames / "frame_000004.png"), "old");
   staging.commit();
-  EXPECT_EQ(read(frames / "frame_000000.png"), "new");
-  EXPECT_EQ(read(frames / "frame_000001.png"), "new");
+  EXPECT_EQ(read_file(frames / "frame_000000.png"), "new");
+  EXPECT_EQ(read_file(frames / "frame_000001.png"), "new");
   for (int i = 2; i < 5; ++i) EXPECT_FALSE(fs::exists(frames / ("frame_00000" + std::to_string(i) + ".png"))) << i;
-  EXPECT_EQ(read(frames / "notes.txt"), "mine");
+  EXPECT_EQ(read_file(frames / "notes.txt"), "mine");
   EXPECT_FALSE(fs::exists(tmp));
 }
 

@@ -21,16 +21,13 @@
 #include "fissure/host_sim/scene_loader.hpp"
 #include "fissure/session/session_error.hpp"
 
+#include "read_file.hpp"
+
 namespace fissure::session {
 namespace {
 namespace fs = std::filesystem;
 
-std::string read(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::read_file;
 
 class SessionRunnerTest : public testing::Test {
  protected:
@@ -55,8 +52,8 @@ class SessionRunnerTest : public testing::Test {
     std::ofstream(out_ / "summary.json") << "{\"earlier\": true}\n";
   }
   void expect_earlier_outputs_untouched() {
-    EXPECT_EQ(read(out_ / "trace.csv"), "time_s,tick\n0,0\n");
-    EXPECT_EQ(read(out_ / "summary.json"), "{\"earlier\": true}\n");
+    EXPECT_EQ(read_file(out_ / "trace.csv"), "time_s,tick\n0,0\n");
+    EXPECT_EQ(read_file(out_ / "summary.json"), "{\"earlier\": true}\n");
     int entries = 0;
     for ([[maybe_unused]] const auto& e : fs::directory_iterator(out_)) ++entries;
     EXPECT_EQ(entries, 2) << "a refused run left a file behind";
@@ -126,7 +123,7 @@ TEST_F(SessionRunnerTest, AnInterruptedSessionStillWritesCompleteOutputs) {
   const SessionOutcome outcome = run_session(options_);
   EXPECT_EQ(outcome.trace_path, out_ / "trace.csv");
   EXPECT_EQ(outcome.summary_path, out_ / "summary.json");
-  const std::string trace = read(out_ / "trace.csv");
+  const std::string trace = read_file(out_ / "trace.csv");
   ASSERT_FALSE(trace.empty());
   EXPECT_EQ(trace.back(), '\n');
   std::istringstream lines(trace);
@@ -139,7 +136,7 @@ TEST_F(SessionRunnerTest, AnInterruptedSessionStillWritesCompleteOutputs) {
     EXPECT_EQ(fields(row), fields(header)) << "row " << rows << ": " << row;
   }
   EXPECT_GT(rows, 0);
-  const nlohmann::json summary = nlohmann::json::parse(read(out_ / "summary.json"));
+  const nlohmann::json summary = nlohmann::json::parse(read_file(out_ / "summary.json"));
   EXPECT_EQ(summary["telemetry_samples"].get<int>(), rows);
   for (const auto& entry : fs::directory_iterator(out_)) {
     EXPECT_NE(entry.path().filename().string().front(), '.') << "temporary left behind: " << entry.path();
