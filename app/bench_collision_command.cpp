@@ -18,12 +18,12 @@ void register_bench_collision(CommandTree& tree) {
     eval::BenchCollisionOptions bench;
   };
   auto a = std::make_shared<Arguments>();
-  CLI::App* cmd = tree.bench.add_subcommand("collision", "Thin-body collision: tunnelling sweep, force-indentation, convergence, cost vs mesh");
+  CLI::App* cmd = tree.bench.add_subcommand("collision", "Thin-body collision: tunnelling sweep (two meshes), levering and clamp-release cells, force-indentation, convergence, cost vs mesh");
   cmd->add_option("--json", a->json_path, "Write the results JSON here")->required();
   cmd->add_flag("--quick", a->bench.quick, "CI-sized run (fewer speeds and meshes, shorter holds)");
   cmd->add_flag("--full", a->bench.full, "More timing samples per cost-vs-mesh row (300 instead of 100); same cells");
   cmd->add_option("--only", a->bench.only, "Run only these parts (default: all; the report needs all)")
-      ->check(CLI::IsMember({"sweep", "indentation", "scaling"}));
+      ->check(CLI::IsMember({"sweep", "cells", "indentation", "scaling"}));
   cmd->callback([a] {
     write_json_file(a->json_path, eval::run_bench_collision(a->bench));
     std::printf("\nwrote %s\n", a->json_path.c_str());

@@ -1,7 +1,10 @@
 // `fissure bench collision --json FILE [--quick | --full]`: the benchmark of the thin-body
-// collision methods. Four parts, every one a table over a knob:
+// collision methods. Five parts, every one a table over a knob:
 //   1. tunnelling sweep: speed × tool × method → crossed nodes, max penetration, force jitter
-//      (detrended), std/mean and drift over a 0.5 s hold, median step time;
+//      (detrended), std/mean, step noise and drift over a 0.5 s hold, cut triangles, median step
+//      time; the paired cells again on a 1280-face icosphere;
+//   1c/d. (part "cells") levering: the blade inserted edge-first and turned 30° about its edge;
+//      clamp release: clamp-sphere's close–hold–open script after four settling times;
 //   2. quasi-static force–indentation: plate into a flat slab (fitted exponent vs n) and
 //      into the sphere (fitted vs the rigid-cap prediction n + 1);
 //   3. mesh convergence: the sphere's force at a fixed depth per mesh size;
@@ -24,6 +27,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fissure/eval/eval_error.hpp"
+#include "fissure/host_sim/contact_cells.hpp"
 #include "fissure/host_sim/host_simulation.hpp"
 #include "fissure/host_sim/plunge_hold.hpp"
 #include "fissure/host_sim/scene_loader.hpp"
@@ -43,6 +47,8 @@ constexpr double kSettleS = host::kPlungeSettle_s;
 // Pose-matching coefficient (Bullet kMT) of the indentation / convergence specimens: the sweep
 // ball's (host/plunge_hold.hpp says why a springy ball).
 constexpr double kShapeMatchingRatio = host::kPlungeShapeMatchingRatio;
+// Issue 22's second sweep mesh: an icosphere ten times finer than the paper's 128-face shell.
+constexpr int kFineSweepFaces = 1280;
 // Depth at which the mesh convergence compares the sphere's force [m].
 constexpr double kConvergenceDepthM = 0.004;
 
@@ -126,19 +132,8 @@ SceneDescription sphere_scene(int faces, bool icosphere) {
   return s;
 }
 
-// ---- 1. Tunnelling sweep: speed × tool × method. ---------------------------------------------
-void run_sweep(const BenchCollisionOptions& o, nlohmann::json& out) {
-  const std::vector<double> speeds = o.quick ? std::vector<double>{0.1, 10.0, 50.0} : std::vector<double>{0.1, 0.5, 1, 2, 5, 10, 20, 50};
-  const auto& tools = host::plunge_tools();
-  const std::vector<SceneCollisionMethod> methods = {SceneCollisionMethod::kBullet, SceneCollisionMethod::kRay, SceneCollisionMethod::kPaired};
-  const double hold_s = o.quick ? 0.1 : 0.5;
-  nlohmann::json sweep = nlohmann::json::array();
-  SimProgress progress("bench collision: sweep", static_cast<long>(speeds.size() * tools.size() * methods.size()));
-  long done = 0;
-  std::printf("\n1. Tunnelling sweep (sphere 128 faces with pose matching kMT %.2f, 1 kHz, plunge %.0f mm, hold %.1f s)\n", kShapeMatchingRatio,
-              host::kPlungeDepth_m * 1e3, hold_s);
-  out["sweep_body"] = {{"faces", 128}, {"shape_matching_ratio", kShapeMatchingRatio}, {"plunge_depth_m", host::kPlungeDepth_m}, {"hold_s", hold_s},
-                       {"hold_settle_s", host::kHoldSettle_s}};
+// ---- 1. Tunnelling sweep: speed × tool × method, on the 128-face ball and (paired) on a 1280-face icosphere.
+void print_sweep_legend(double hold_s) {
   std::printf("(hold: |F| every step for %.1f s after a %.0f ms settling window, fitted by a line; in %% of the mean force:\n"
               " jitter = residual std about the line, std = plain std, step = std of the step-to-step change / sqrt 2,\n"
               " drift = the line's change over the hold (the soft body relaxing); 'lost' = no contact left in the hold)\n", hold_s, host::kHoldSettle_s * 1e3);
@@ -146,8 +141,17 @@ void run_sweep(const BenchCollisionOptions& o, nlohmann::json& out) {
               host::kInsideToleranceM * 1e3);
   std::printf("%-17s %-7s %7s | %7s %7s %7s | %9s %8s %8s %8s %8s %9s %9s %9s\n", "tool", "method", "v m/s", "crossed", "wrong", "inside", "pen mm",
               "jitter%", "std%", "step%", "drift%", "F_hold N", "med us", "cut");
+}
+
+// One sweep table: every tool × method × speed on the ball of `icosphere_faces` (0: the paper's 128-face shell).
+nlohmann::json sweep_cells(const std::vector<double>& speeds, const std::vector<SceneCollisionMethod>& methods, int icosphere_faces, double hold_s,
+                           const char* progress_name) {
+  const auto& tools = host::plunge_tools();
+  nlohmann::json sweep = nlohmann::json::array();
+  SimProgress progress(progress_name, static_cast<long>(speeds.size() * tools.size() * methods.size()));
+  long done = 0;
   for (const host::PlungeTool& tool : tools) {
-    const SceneDescription scene = host::plunge_scene(tool);
+    const SceneDescription scene = host::plunge_scene(tool, icosphere_faces);
     const std::string tool_name(tool.name);
     for (SceneCollisionMethod method : methods) {
       for (double v : speeds) {
@@ -178,7 +182,70 @@ void run_sweep(const BenchCollisionOptions& o, nlohmann::json& out) {
     }
   }
   progress.finish("");
-  out["sweep"] = sweep;
+  return sweep;
+}
+
+void run_sweep(const BenchCollisionOptions& o, nlohmann::json& out) {
+  const std::vector<double> speeds = o.quick ? std::vector<double>{0.1, 10.0, 50.0} : std::vector<double>{0.1, 0.5, 1, 2, 5, 10, 20, 50};
+  const double hold_s = o.quick ? 0.1 : 0.5;
+  std::printf("\n1. Tunnelling sweep (sphere 128 faces with pose matching kMT %.2f, 1 kHz, plunge %.0f mm, hold %.1f s)\n", kShapeMatchingRatio,
+              host::kPlungeDepth_m * 1e3, hold_s);
+  out["sweep_body"] = {{"faces", 128}, {"shape_matching_ratio", kShapeMatchingRatio}, {"plunge_depth_m", host::kPlungeDepth_m}, {"hold_s", hold_s},
+                       {"hold_settle_s", host::kHoldSettle_s}};
+  print_sweep_legend(hold_s);
+  out["sweep"] = sweep_cells(speeds, {SceneCollisionMethod::kBullet, SceneCollisionMethod::kRay, SceneCollisionMethod::kPaired}, 0, hold_s,
+                             "bench collision: sweep");
+  std::printf("\n1b. The same paired cells on a %d-face icosphere (issue 22's second mesh)\n", kFineSweepFaces);
+  out["sweep_fine_body"] = {{"faces", kFineSweepFaces}, {"tessellation", "icosphere"}, {"shape_matching_ratio", kShapeMatchingRatio},
+                            {"plunge_depth_m", host::kPlungeDepth_m}, {"hold_s", hold_s}, {"hold_settle_s", host::kHoldSettle_s}};
+  print_sweep_legend(hold_s);
+  out["sweep_fine"] = sweep_cells(speeds, {SceneCollisionMethod::kPaired}, kFineSweepFaces, hold_s, "bench collision: sweep, 1280 faces");
+}
+
+// ---- 1c. Levering and clamp-release cells (issue 22) -------------------------------------------
+void run_motion_cells(const BenchCollisionOptions& o, nlohmann::json& out) {
+  const double hold_s = o.quick ? 0.1 : 0.5;
+  std::printf("\n1c. Levering: the 1 mm blade inserted edge-first %.0f mm at %.1f m/s, turned %.0f deg about its edge at %.1f rad/s, held %.1f s\n",
+              host::kPlungeDepth_m * 1e3, host::kLeverInsertSpeed_m_s, host::kLeverAngle_rad * 180.0 / 3.141592653589793, host::kLeverRate_rad_s,
+              hold_s);
+  std::printf("%-8s %-7s | %7s %7s %9s | %9s %8s %8s %9s | %9s %9s\n", "mesh", "method", "crossed", "inside", "pen mm", "cut max", "cut stp", "steps",
+              "F_hold N", "jitter%", "step%");
+  nlohmann::json lever = nlohmann::json::array();
+  for (const int faces : {0, kFineSweepFaces}) {
+    const SceneDescription scene = host::plunge_scene(host::plunge_tools()[2], faces);
+    for (SceneCollisionMethod method : {SceneCollisionMethod::kBullet, SceneCollisionMethod::kPaired}) {
+      const host::LeverResult r = host::run_lever_hold(scene, method, hold_s);
+      const int mesh = faces == 0 ? 128 : faces;
+      std::printf("%-8d %-7s | %7d %7d %9.3f | %9d %8d %8d %9.3f | %9.3f %9.3f\n", mesh, host::to_string(method), r.crossed_nodes, r.inside_nodes,
+                  r.max_penetration_m * 1e3, r.max_cut_triangles, r.steps_with_cut_triangles, r.steps, r.hold.mean_n, 100.0 * r.hold.jitter,
+                  100.0 * r.hold.step_noise);
+      const auto if_contact = [&](double x) { return r.hold.in_contact ? nlohmann::json(x) : nlohmann::json(nullptr); };
+      lever.push_back({{"faces", mesh}, {"method", host::to_string(method)}, {"crossed_nodes", r.crossed_nodes}, {"inside_nodes", r.inside_nodes},
+                       {"max_penetration_m", r.max_penetration_m}, {"max_cut_triangles", r.max_cut_triangles},
+                       {"steps_with_cut_triangles", r.steps_with_cut_triangles}, {"steps", r.steps}, {"hold_force_n", r.hold.mean_n},
+                       {"force_jitter", if_contact(r.hold.jitter)}, {"force_step_noise", if_contact(r.hold.step_noise)},
+                       {"step_median_us", sim_quantile(r.step_s, 0.5) * 1e6}});
+    }
+  }
+  out["lever"] = lever;
+
+  const SceneDescription clamp = host::load_scene(host::resolve_scene_path("clamp-sphere"));
+  std::printf("\n1d. Clamp release: clamp-sphere's script (close, hold, open fully) after settling; the larger jaw's |F| from the %dth fully open step\n",
+              host::kClampOpenGraceSteps + 1);
+  std::printf("%-8s %-7s | %9s %9s %9s | %7s %9s %9s\n", "settle s", "method", "F_max N", "open N", "open stp", "crossed", "cut max", "cut stp");
+  nlohmann::json release = nlohmann::json::array();
+  for (const double settle_s : {0.1, 0.2, 0.3, 0.5}) {
+    for (SceneCollisionMethod method : {SceneCollisionMethod::kBullet, SceneCollisionMethod::kPaired}) {
+      const host::ClampReleaseResult r = host::run_clamp_release(clamp, method, settle_s);
+      std::printf("%-8.2f %-7s | %9.3f %9.4f %9d | %7d %9d %9d\n", settle_s, host::to_string(method), r.script_max_force_n, r.open_force_max_n,
+                  r.open_steps, r.crossed_nodes, r.max_cut_triangles, r.steps_with_cut_triangles);
+      release.push_back({{"settle_s", settle_s}, {"method", host::to_string(method)}, {"script_max_force_n", r.script_max_force_n},
+                         {"open_force_max_n", r.open_force_max_n}, {"open_steps", r.open_steps}, {"open_grace_steps", host::kClampOpenGraceSteps},
+                         {"crossed_nodes", r.crossed_nodes}, {"max_penetration_m", r.max_penetration_m}, {"max_cut_triangles", r.max_cut_triangles},
+                         {"steps_with_cut_triangles", r.steps_with_cut_triangles}, {"step_median_us", sim_quantile(r.step_s, 0.5) * 1e6}});
+    }
+  }
+  out["clamp_release"] = release;
 }
 
 // ---- 2. Quasi-static force-indentation: a flat slab and the finest sphere. --------------------
@@ -433,6 +500,11 @@ nlohmann::json run_parts(const BenchCollisionOptions& o) {
   if (o.runs("sweep")) {
     run_sweep(o, out);
     out["sweep_seconds"] = seconds_since(bench_start);
+  }
+  if (o.runs("cells")) {
+    const Clock::time_point cells_start = Clock::now();
+    run_motion_cells(o, out);
+    out["cells_seconds"] = seconds_since(cells_start);
   }
   const std::vector<int> mesh_faces = o.quick ? std::vector<int>{320, 1280, 5120} : std::vector<int>{320, 1280, 5120, 20480};
   if (o.runs("indentation")) {

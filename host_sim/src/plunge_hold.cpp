@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <variant>
 
 #include "fissure/host_sim/host_simulation.hpp"
 #include "fissure/host_sim/scene_loader.hpp"
@@ -18,7 +19,7 @@ const std::array<PlungeTool, 4>& plunge_tools() {
   return tools;
 }
 
-SceneDescription plunge_scene(const PlungeTool& tool) {
+SceneDescription plunge_scene(const PlungeTool& tool, int icosphere_faces) {
   SceneDescription s = load_scene(resolve_scene_path("spatula-sphere"));
   if (tool.kind == ToolKind::kConvexMesh) {
     s.tool = load_scene(resolve_scene_path("convex-spatula-sphere")).tool;
@@ -28,6 +29,12 @@ SceneDescription plunge_scene(const PlungeTool& tool) {
   }
   s.trajectory.start.orientation_world = quat_from_rpy_deg(tool.orientation_rpy_deg);
   s.soft_body.shape_matching_ratio = kPlungeShapeMatchingRatio;
+  if (icosphere_faces > 0) {
+    SoftSphere sphere = std::get<SoftSphere>(s.soft_body.shape);
+    sphere.faces_count = icosphere_faces;
+    sphere.tessellation = SphereTessellation::kIcosphere;
+    s.soft_body.shape = sphere;
+  }
   return s;
 }
 

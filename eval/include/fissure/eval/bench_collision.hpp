@@ -11,7 +11,7 @@ namespace fissure::eval {
 struct BenchCollisionOptions {
   bool quick = false;              ///< CI-sized: fewer speeds and meshes, shorter holds
   bool full = false;               ///< more timing samples per cost-vs-mesh row; the same cells
-  std::vector<std::string> only;   ///< parts to run (empty: all): sweep, indentation, scaling
+  std::vector<std::string> only;   ///< parts to run (empty: all): sweep, cells, indentation, scaling
   [[nodiscard]] bool runs(const char* part) const;
 };
 

