@@ -466,6 +466,48 @@ def section_tunnelling(report, data, problems, targets):
                                      f"{r['hold_max_cut_triangles']} / {r['hold_steps_with_cut_triangles']}"))
     report.add(targets_table([t for t in targets if t.section == "collision sweep"]))
 
+    fine = col.get("sweep_fine") or []
+    if fine:
+        faces = (col.get("sweep_fine_body") or {}).get("faces", "?")
+        fcell = {(r["tool"], r["speed_m_s"]): r for r in fine}
+        ftools = list(dict.fromkeys(r["tool"] for r in fine))
+        fspeeds = sorted({r["speed_m_s"] for r in fine})
+
+        def fine_text(r):
+            if not r.get("hold_in_contact"):
+                return f"lost, cut {r['hold_max_cut_triangles']}/{r['hold_steps_with_cut_triangles']}"
+            return (f"{r['crossed_nodes']} / {100 * r['force_jitter']:.2f}% / {100 * r['force_step_noise']:.2f}% / "
+                    f"{r['hold_max_cut_triangles']}·{r['hold_steps_with_cut_triangles']}")
+        report.add(f"The same paired cells on a {faces}-face icosphere: crossed nodes / hold jitter / step noise / cut triangles "
+                   "(most on a hold step · hold steps with any).")
+        report.add("")
+        report.add(table(["tool"] + [f"{v:g} m/s" for v in fspeeds],
+                         [[t] + [fine_text(fcell[(t, v)]) if (t, v) in fcell else "—" for v in fspeeds] for t in ftools]))
+    lever = col.get("lever") or []
+    if lever:
+        report.add("### Levering and clamp release (issue 22)")
+        report.add("")
+        report.add("Levering: the 1 mm blade inserted edge-first 20 mm at 0.1 m/s, turned 30° about its leading edge at 1 rad/s, "
+                   "held 0.5 s. Cut triangles over every step of the cell (insert, turn, hold).")
+        report.add("")
+        report.add(table(["mesh faces", "method", "crossed", "pen mm", "cut max / steps", "F_hold N", "jitter", "step noise", "median step µs"],
+                         [[r["faces"], r["method"], r["crossed_nodes"], f"{r['max_penetration_m'] * 1e3:.3f}",
+                           f"{r['max_cut_triangles']} / {r['steps_with_cut_triangles']} of {r['steps']}", f"{r['hold_force_n']:.3f}",
+                           "lost" if r.get("force_jitter") is None else f"{100 * r['force_jitter']:.2f} %",
+                           "lost" if r.get("force_step_noise") is None else f"{100 * r['force_step_noise']:.2f} %",
+                           f"{r['step_median_us']:.0f}"] for r in lever]))
+    release = col.get("clamp_release") or []
+    if release:
+        grace = release[0].get("open_grace_steps", 5)
+        report.add(f"Clamp release: clamp-sphere's script (close on the ball, hold, open fully) after the ball settled; the larger "
+                   f"jaw's force from the {grace + 1}th fully open step on (target 0 N within 5 ms).")
+        report.add("")
+        report.add(table(["settled s", "method", "max F N", "open F N", "crossed", "cut max / steps"],
+                         [[f"{r['settle_s']:g}", r["method"], f"{r['script_max_force_n']:.3f}", f"{r['open_force_max_n']:.4f}",
+                           r["crossed_nodes"], f"{r['max_cut_triangles']} / {r['steps_with_cut_triangles']}"] for r in release]))
+    if fine or lever or release:
+        report.add(targets_table([t for t in targets if t.section == "contact"]))
+
     report.add("### Force–indentation and mesh convergence")
     report.add("")
     ind = col.get("indentation")
