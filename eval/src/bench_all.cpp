@@ -78,7 +78,7 @@ std::vector<Child> children(const fs::path& out_dir) {
       // best_effort: on a machine without SCHED_FIFO the tick/Z-width parts still run and the
       // JSON says what could not be had (wakeup_us.*.sched_fifo), instead of no rt figures.
       {"rt", {"bench", "rt"}, {"--rt-policy", "best_effort"}, {"--rt-policy", "best_effort", "--seconds", "3"}, 75, 20},
-      {"collision", {"bench", "collision"}, {}, {"--quick"}, 105, 15},
+      {"collision", {"bench", "collision"}, {}, {"--quick"}, 150, 30},
       {"proxy", {"bench", "proxy"}, {}, {"--host-rates", "1000", "100"}, 5, 3},
       {"pareto", {"bench", "pareto"}, {}, {"--quick", "--repeats", "1"}, 12, 4},
       {"view", {"bench", "view"}, {"--out", view_runs}, {"--repeats", "1", "--out", view_runs}, 25, 9},
