@@ -18,7 +18,7 @@ namespace fissure::host::test_oracle {
 
 namespace {
 
-using Bvh = fcl::BVHModel<fcl::OBBRSSd>;
+using Bvh = fcl::BVHModel<fcl::AABBd>;  // AABB: the cheapest to build, and the mesh is rebuilt for every pose
 
 // A convex hull computed by Bullet (float inside); its vertices mapped back to the nearest of the
 // double-precision input points, its faces as loops of those input indices.
@@ -242,6 +242,20 @@ Agreement compare(const std::vector<char>& project, const std::vector<char>& ora
     a.beyond_margin += explained ? 0 : 1;
   }
   return a;
+}
+
+void RunTally::add(const Agreement& triangles, const Agreement& nodes) {
+  ++steps;
+  project_max_cut = std::max(project_max_cut, triangles.project);
+  oracle_max_cut = std::max(oracle_max_cut, triangles.oracle);
+  project_steps_with_cut += triangles.project > 0 ? 1 : 0;
+  oracle_steps_with_cut += triangles.oracle > 0 ? 1 : 0;
+  project_max_inside = std::max(project_max_inside, nodes.project);
+  oracle_max_inside = std::max(oracle_max_inside, nodes.oracle);
+  triangles_differ += triangles.differ;
+  triangles_beyond_margin += triangles.beyond_margin;
+  nodes_differ += nodes.differ;
+  nodes_beyond_margin += nodes.beyond_margin;
 }
 
 }  // namespace fissure::host::test_oracle

@@ -12,7 +12,7 @@
 //     with every face moved t inward, its vertices solved in double precision from the planes
 //     that meet at each (found through the dual hull) — the tool's volume from its vertices, not
 //     from the project's plane list;
-//   * the test: FCL's mesh–convex collision (fcl::collide of a BVHModel<OBBRSS> of the soft
+//   * the test: FCL's mesh–convex collision (fcl::collide of a BVHModel<AABB> of the soft
 //     triangles against an fcl::Convex of the shrunk hull, boolean, every colliding triangle
 //     reported; libccd's MPR for each triangle–convex pair); a node is inside when an
 //     fcl::Sphere of kNodeRadiusM at it collides with the shrunk hull.
@@ -67,6 +67,17 @@ struct Agreement {
 };
 [[nodiscard]] Agreement compare(const std::vector<char>& project, const std::vector<char>& oracle, const std::vector<char>& oracle_loose,
                                 const std::vector<char>& oracle_strict);
+
+/// Agreement over the steps of a run: the cut-triangle and inside-node figures of both sides.
+struct RunTally {
+  int steps = 0;
+  int project_max_cut = 0, oracle_max_cut = 0;                ///< most triangles cut on one step
+  int project_steps_with_cut = 0, oracle_steps_with_cut = 0;  ///< steps with any
+  int project_max_inside = 0, oracle_max_inside = 0;          ///< most nodes inside on one step
+  long triangles_differ = 0, triangles_beyond_margin = 0;     ///< summed over the steps
+  long nodes_differ = 0, nodes_beyond_margin = 0;
+  void add(const Agreement& triangles, const Agreement& nodes);
+};
 
 /// The tool (a rigid convex body given by its vertices, tool frame) shrunk by t and t ∓ margin.
 class FclToolOracle {
