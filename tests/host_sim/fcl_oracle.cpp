@@ -193,7 +193,7 @@ FclToolOracle& FclToolOracle::operator=(FclToolOracle&&) noexcept = default;
 const std::vector<Eigen::Vector3d>& FclToolOracle::shrunk_vertices_tool_m() const { return impl_->shrunk_vertices; }
 
 OracleCounts FclToolOracle::check(const std::vector<Eigen::Vector3d>& soft_nodes_world_m, const std::vector<std::array<int, 3>>& faces,
-                                  const Eigen::Isometry3d& tool_to_world) const {
+                                  const Eigen::Isometry3d& tool_to_world, bool with_margins) const {
   OracleCounts out;
   if (!faces.empty()) {
     Bvh mesh;
@@ -206,8 +206,10 @@ OracleCounts FclToolOracle::check(const std::vector<Eigen::Vector3d>& soft_nodes
     mesh.addSubModel(points, triangles);
     mesh.endModel();
     out.cut = colliding_triangles(mesh, faces.size(), *impl_->at_tolerance.convex, tool_to_world);
-    out.cut_loose = colliding_triangles(mesh, faces.size(), *impl_->loose.convex, tool_to_world);
-    out.cut_strict = colliding_triangles(mesh, faces.size(), *impl_->strict.convex, tool_to_world);
+    if (with_margins) {
+      out.cut_loose = colliding_triangles(mesh, faces.size(), *impl_->loose.convex, tool_to_world);
+      out.cut_strict = colliding_triangles(mesh, faces.size(), *impl_->strict.convex, tool_to_world);
+    }
   }
   const Eigen::Isometry3d world_to_tool = tool_to_world.inverse();
   const fcl::Sphered node(kNodeRadiusM);
@@ -215,6 +217,7 @@ OracleCounts FclToolOracle::check(const std::vector<Eigen::Vector3d>& soft_nodes
     const Eigen::Vector3d p = world_to_tool * p_world;
     const bool near = impl_->tool_bounds.exteriorDistance(p) <= kNodeRadiusM;
     out.inside.push_back(near && node_collides(node, p, *impl_->at_tolerance.convex) ? 1 : 0);
+    if (!with_margins) continue;
     out.inside_loose.push_back(near && node_collides(node, p, *impl_->loose.convex) ? 1 : 0);
     out.inside_strict.push_back(near && node_collides(node, p, *impl_->strict.convex) ? 1 : 0);
   }
@@ -230,7 +233,7 @@ int OracleCounts::count(const std::vector<char>& flags) { return static_cast<int
 Agreement compare(const std::vector<char>& project, const std::vector<char>& oracle, const std::vector<char>& oracle_loose,
                   const std::vector<char>& oracle_strict) {
   if (project.size() != oracle.size() || oracle_loose.size() != oracle.size() || oracle_strict.size() != oracle.size())
-    throw std::invalid_argument("test_oracle::compare: the four flag lists must have one entry per item");
+    throw std::invalid_argument("test_oracle::compare: the four flag lists must have one entry per item (check() with margins)");
   Agreement a;
   for (std::size_t i = 0; i < project.size(); ++i) {
     a.project += project[i] != 0 ? 1 : 0;

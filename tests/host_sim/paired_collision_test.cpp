@@ -472,7 +472,9 @@ TEST(PairedCollision, RandomPosesVelocitiesAndSpinsKeepTheInvariants) {
         }
         for (std::size_t i = 0; i < nodes.size(); ++i)
           inside[i] = -tool.signed_distance_m(current.to_tool(nodes[i])) > test_scene::CrossingTracker::kInsideTolerance_m ? 1 : 0;
-        const test_oracle::OracleCounts o = oracle.check(nodes, faces, tool_to_world);
+        test_oracle::OracleCounts o = oracle.check(nodes, faces, tool_to_world, false);
+        if (o.cut != cut || o.inside != inside) o = oracle.check(nodes, faces, tool_to_world, true);  // the margins decide
+        else o.cut_loose = o.cut_strict = o.cut, o.inside_loose = o.inside_strict = o.inside;      // identical at t: nothing to decide
         const test_oracle::Agreement triangles = test_oracle::compare(cut, o.cut, o.cut_loose, o.cut_strict);
         EXPECT_EQ(triangles.project, triangles_cut_by_volume(volume, nodes, near_faces, tool_to_world, kInsideToleranceM))
             << "run " << run << " step " << s << ": the count is the per-triangle test summed";
