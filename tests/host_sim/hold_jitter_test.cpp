@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstdio>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -29,8 +30,10 @@ const double kSpeedsMS[] = {0.1, 0.5, 1, 2, 5, 10, 20, 50};
 
 class PairedSweepHold : public ::testing::TestWithParam<int> {};
 
-// The FCL oracle (fcl_oracle.hpp) for the scene's tool, at the metrics' tolerance.
+// The FCL oracle (fcl_oracle.hpp) for the scene's tool (one rigid part: the sweep's tools), at
+// the metrics' tolerance.
 test_oracle::FclToolOracle oracle_for(const SceneDescription& scene) {
+  if (scene.tool.kind == ToolKind::kClamp) throw std::invalid_argument("oracle_for: a clamp has two parts; the sweep has none");
   if (scene.tool.kind == ToolKind::kConvexMesh) {
     std::vector<Eigen::Vector3d> vertices;
     for (const Vec3& v : scene.tool.mesh_vertices_tool_m) vertices.emplace_back(v[0], v[1], v[2]);
@@ -80,7 +83,9 @@ struct HoldOracleCheck {
 };
 
 // The mandatory invariants in every cell: no crossed node, penetration ≤ 0.1 mm, and the held
-// tool still presses the ball. The jitter is printed (the table for the issue's note).
+// tool still presses the ball. The jitter is printed (the table for the issue's note). On every
+// hold step the cut-triangle and inside-node counts must agree with the FCL oracle's; the cut
+// count itself is not asserted to be zero (today's design leaves some: issue 22).
 TEST_P(PairedSweepHold, NoCrossingNoPenetrationAndContactAtEverySpeed) {
   const PlungeTool& tool = plunge_tools()[static_cast<std::size_t>(GetParam())];
   const SceneDescription scene = plunge_scene(tool);
