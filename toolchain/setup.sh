@@ -11,6 +11,7 @@ packages=(
   cmake g++ ninja-build pkg-config
   # libraries (BRIEF §2: shared/ uses only Eigen; host_sim adds Bullet; tools add the rest)
   libeigen3-dev libbullet-dev libgtest-dev libgmock-dev libbenchmark-dev
+  libfcl-dev  # tests/host_sim only: the independent triangle–convex oracle of the contact metrics (fcl_oracle.hpp)
   libusb-1.0-0-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libspdlog-dev
   libtinyobjloader-dev
   libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libglfw3-dev libpng-dev  # viewer/: headless EGL (llvmpipe), GL 3.3, GLFW window, PNG

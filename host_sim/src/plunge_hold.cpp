@@ -76,7 +76,7 @@ HoldForceStats hold_force_stats(const std::vector<double>& force_n) {
 }
 
 PlungeHoldResult run_plunge_hold(const SceneDescription& scene, SceneCollisionMethod method, double speed_m_s, double leading_half_m,
-                                 double hold_s, bool count_cut_triangles) {
+                                 double hold_s, bool count_cut_triangles, const HoldStepObserver& on_hold_step) {
   HostSimulation sim(scene, method);
   const double dt = scene.simulation.time_step_s;
   // Start well clear, settle, then find the soft surface's top.
@@ -131,6 +131,7 @@ PlungeHoldResult run_plunge_hold(const SceneDescription& scene, SceneCollisionMe
       const int cut = sim.triangles_cut_by_tool(kInsideToleranceM);
       result.hold_max_cut_triangles = std::max(result.hold_max_cut_triangles, cut);
       if (cut > 0) ++result.hold_steps_with_cut_triangles;
+      if (on_hold_step) on_hold_step(sim, cut);
     }
   }
   result.ball_centre_hold_end_world_m = ball_centre();

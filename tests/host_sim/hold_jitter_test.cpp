@@ -4,12 +4,20 @@
 // (host_sim/plunge_hold.hpp, shared with the bench; paired method only, default
 // ThinBodyCollisionParams): the tool driven 20 mm into the settled 128-face ball at the cell's
 // speed, then held; jitter = residual std about a line through |F| over 0.5 s / mean.
+#include <BulletSoftBody/btSoftBody.h>
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdio>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
+#include "fcl_oracle.hpp"
+#include "fissure/host_sim/contact_metrics.hpp"
+#include "fissure/host_sim/host_simulation.hpp"
 #include "fissure/host_sim/plunge_hold.hpp"
+#include "fissure/host_sim/soft_world.hpp"
 
 namespace fissure::host {
 namespace {
@@ -22,13 +30,73 @@ const double kSpeedsMS[] = {0.1, 0.5, 1, 2, 5, 10, 20, 50};
 
 class PairedSweepHold : public ::testing::TestWithParam<int> {};
 
+// The FCL oracle (fcl_oracle.hpp) for the scene's tool (one rigid part: the sweep's tools), at
+// the metrics' tolerance.
+test_oracle::FclToolOracle oracle_for(const SceneDescription& scene) {
+  if (scene.tool.kind == ToolKind::kClamp) throw std::invalid_argument("oracle_for: a clamp has two parts; the sweep has none");
+  if (scene.tool.kind == ToolKind::kConvexMesh) {
+    std::vector<Eigen::Vector3d> vertices;
+    for (const Vec3& v : scene.tool.mesh_vertices_tool_m) vertices.emplace_back(v[0], v[1], v[2]);
+    return test_oracle::FclToolOracle(vertices, kInsideToleranceM);
+  }
+  const Vec3& size = scene.tool.box_size_m;
+  return test_oracle::FclToolOracle::from_box(0.5 * Eigen::Vector3d(size[0], size[1], size[2]), kInsideToleranceM);
+}
+
+// Checks every hold step's cut-triangle count (HostSimulation::triangles_cut_by_tool) and
+// inside-node count (the metrics' tracker) against the oracle. Both are counts, so agreement is
+// asked of the counts: the oracle at t + margin ≤ the project's ≤ the oracle at t − margin.
+struct HoldOracleCheck {
+  const test_oracle::FclToolOracle& oracle;
+  std::vector<std::array<int, 3>> faces;
+  test_oracle::RunTally tally;
+  int cut_outside_bracket = 0, inside_outside_bracket = 0;
+
+  void operator()(HostSimulation& sim, int cut_triangles) {
+    if (faces.empty()) {
+      const btSoftBody& soft = sim.world().soft();
+      for (int f = 0; f < soft.m_faces.size(); ++f)
+        faces.push_back({static_cast<int>(soft.m_faces[f].m_n[0] - &soft.m_nodes[0]), static_cast<int>(soft.m_faces[f].m_n[1] - &soft.m_nodes[0]),
+                         static_cast<int>(soft.m_faces[f].m_n[2] - &soft.m_nodes[0])});
+    }
+    std::array<ToolPose, kMaxToolParts> parts{};
+    tool_part_poses(sim.scene(), sim.tool_pose(), 0.0, parts);
+    using C = test_oracle::OracleCounts;
+    const int inside = sim.last().crossing.inside_nodes;
+    C o = oracle.check(sim.node_positions_world_m(), faces, to_isometry(parts[0]), false);
+    if (C::count(o.cut) != cut_triangles || C::count(o.inside) != inside) {
+      // The counts differ at t: the margins decide.
+      o = oracle.check(sim.node_positions_world_m(), faces, to_isometry(parts[0]), true);
+      const auto bracketed = [](int project, int strict, int loose) { return strict <= project && project <= loose; };
+      if (!bracketed(cut_triangles, C::count(o.cut_strict), C::count(o.cut_loose))) ++cut_outside_bracket;
+      if (!bracketed(inside, C::count(o.inside_strict), C::count(o.inside_loose))) ++inside_outside_bracket;
+    }
+    test_oracle::Agreement triangles, nodes;
+    triangles.project = cut_triangles;
+    triangles.oracle = C::count(o.cut);
+    triangles.differ = triangles.project != triangles.oracle ? 1 : 0;
+    nodes.project = inside;
+    nodes.oracle = C::count(o.inside);
+    nodes.differ = nodes.project != nodes.oracle ? 1 : 0;
+    tally.add(triangles, nodes);
+  }
+};
+
 // The mandatory invariants in every cell: no crossed node, penetration ≤ 0.1 mm, and the held
-// tool still presses the ball. The jitter is printed (the table for the issue's note).
+// tool still presses the ball. The jitter is printed (the table for the issue's note). On every
+// hold step the cut-triangle and inside-node counts must agree with the FCL oracle's; the cut
+// count itself is not asserted to be zero (today's design leaves some: issue 22).
 TEST_P(PairedSweepHold, NoCrossingNoPenetrationAndContactAtEverySpeed) {
   const PlungeTool& tool = plunge_tools()[static_cast<std::size_t>(GetParam())];
   const SceneDescription scene = plunge_scene(tool);
+  // One sub-step per host step: the tracker's inside count (worst sub-step) is then the count at
+  // the pose the oracle is asked about.
+  ASSERT_EQ(scene.simulation.substeps_count, 1);
+  const test_oracle::FclToolOracle oracle = oracle_for(scene);
   for (const double speed : kSpeedsMS) {
-    const PlungeHoldResult c = run_plunge_hold(scene, SceneCollisionMethod::kPaired, speed, tool.leading_half_m, kHoldS, true);
+    HoldOracleCheck check{oracle, {}, {}, 0, 0};
+    const PlungeHoldResult c = run_plunge_hold(scene, SceneCollisionMethod::kPaired, speed, tool.leading_half_m, kHoldS, true,
+                                               [&check](HostSimulation& sim, int cut) { check(sim, cut); });
     // The diagnosis beside the figure: does the contact set change, does the ball move, and are
     // soft triangles cut by the tool with no node inside it (the crossed count cannot see those)?
     const int set_changes = c.hold_contact_set_changes;
@@ -39,9 +107,18 @@ TEST_P(PairedSweepHold, NoCrossingNoPenetrationAndContactAtEverySpeed) {
                 std::string(tool.name).c_str(), speed, c.crossed_nodes, c.max_penetration_m * 1e3, c.hold.mean_n, 100.0 * c.hold.jitter,
                 set_changes, (b[0] - a[0]) * 1e3, (b[2] - a[2]) * 1e3, c.hold_max_cut_triangles, c.hold_steps_with_cut_triangles,
                 c.hold_force_n.size());
+    const test_oracle::RunTally& t = check.tally;
+    std::printf("%-17s %5.1f m/s: oracle over %d hold steps: cut triangles max %d on %d steps (project max %d on %d), "
+                "steps whose counts differ %ld (outside the margin %d); nodes inside max %d (project %d), differ %ld (outside %d)\n",
+                std::string(tool.name).c_str(), speed, t.steps, t.oracle_max_cut, t.oracle_steps_with_cut, t.project_max_cut,
+                t.project_steps_with_cut, t.triangles_differ, check.cut_outside_bracket, t.oracle_max_inside, t.project_max_inside,
+                t.nodes_differ, check.inside_outside_bracket);
     EXPECT_EQ(c.crossed_nodes, 0) << tool.name << " at " << speed << " m/s";
     EXPECT_LE(c.max_penetration_m, kMaxPenetrationM) << tool.name << " at " << speed << " m/s";
     EXPECT_GT(c.hold.mean_n, 0.0) << tool.name << " at " << speed << " m/s: the held tool lost the ball";
+    EXPECT_EQ(t.steps, static_cast<int>(c.hold_force_n.size())) << "the oracle saw every hold step";
+    EXPECT_EQ(check.cut_outside_bracket, 0) << tool.name << " at " << speed << " m/s: the oracle and triangles_cut_by_tool disagree";
+    EXPECT_EQ(check.inside_outside_bracket, 0) << tool.name << " at " << speed << " m/s: the oracle and the tracker disagree on nodes inside";
   }
 }
 

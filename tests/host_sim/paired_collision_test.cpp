@@ -1,8 +1,10 @@
 // The paired-node thin-body collision end to end on a real Bullet soft body (BRIEF §3, issue 5):
 // no crossed node at any speed, penetration ≤ 0.1 mm, finite forces, nothing done out of
 // contact, deterministic, F ∝ dⁿ on a flat slab with area weighting, no allocation per step.
+#include "fcl_oracle.hpp"
 #include "soft_scene_fixture.hpp"
 
+#include <fissure/host_sim/contact_metrics.hpp>
 #include <fissure/host_sim/host_simulation.hpp>
 #include <fissure/host_sim/scene_loader.hpp>
 #include <fissure/host_sim/thin_body_collision.hpp>
@@ -390,19 +392,44 @@ TEST(PairedCollision, EdgeFirstStepDoesNotAllocateInContact) {
 // Invariant fuzz: random tool orientations, approach directions, speeds (0.1–20 m/s) and spins
 // (≤ 5 rad/s) through the sphere — no crossed node, no node deeper than 0.1 mm in the tool,
 // finite forces and positions. Fixed seed: deterministic.
+// On every step the FCL oracle (fcl_oracle.hpp) answers the same two questions independently:
+// which soft triangles reach deeper than 0.1 mm into the tool (the project's clip,
+// ToolVolume::reaches_inside, triangle by triangle) and which nodes lie deeper than 0.1 mm inside
+// (the fixture's tracker's test); the two must agree on every triangle and node, up to the
+// oracle's 1 µm depth margin. Cut triangles are not asserted to be zero here: today's design
+// leaves some (issue 22); the assertion is that both rulers count the same ones.
 TEST(PairedCollision, RandomPosesVelocitiesAndSpinsKeepTheInvariants) {
   std::mt19937 rng(20261121);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   std::uniform_real_distribution<double> speed_log10(-1.0, std::log10(20.0));
   const ToolNodes plate = test_scene::plate_tool(0.002);
-  const ToolNodes spatula = make_tool(Tool::kConvexSpatula);
+  RoundedSpatulaParams spatula_params;  // make_tool(Tool::kConvexSpatula)'s mesh
+  const ConvexMeshToolShape spatula_mesh = make_rounded_spatula_mesh(spatula_params, 3.0 * spatula_params.thickness_m);
+  const ToolNodes spatula = ToolNodes::from_convex_mesh(spatula_mesh);
+  const Eigen::Vector3d plate_half_m(0.02, 0.001, 0.02);  // test_scene::plate_tool(0.002)
+  const ToolVolume plate_volume = ToolVolume::from_box(plate_half_m);
+  const ToolVolume spatula_volume = ToolVolume::from_convex_mesh(spatula_mesh.vertices_tool_m, spatula_mesh.triangles);
+  const test_oracle::FclToolOracle plate_oracle = test_oracle::FclToolOracle::from_box(plate_half_m, kInsideToleranceM);
+  const test_oracle::FclToolOracle spatula_oracle(spatula_mesh.vertices_tool_m, kInsideToleranceM);
   const Eigen::Vector3d centre(0, test_scene::kSphereRadius_m, 0);
   int runs_with_contact = 0;
+  test_oracle::RunTally all_runs;
+  std::vector<Eigen::Vector3d> clip_scratch;
   for (int run = 0; run < 16; ++run) {
     const ToolNodes& tool = run % 2 == 0 ? plate : spatula;
+    const ToolVolume& volume = run % 2 == 0 ? plate_volume : spatula_volume;
+    const test_oracle::FclToolOracle& oracle = run % 2 == 0 ? plate_oracle : spatula_oracle;
+    Eigen::AlignedBox3d tool_bounds;  // tool frame
+    for (const Eigen::Vector3d& v : tool.hull_vertices_tool_m()) tool_bounds.extend(v);
     test_scene::SoftWorld world(true);
     world.add_sphere();
     for (int i = 0; i < 60; ++i) world.step_dynamics();
+    std::vector<std::array<int, 3>> faces;
+    for (int f = 0; f < world.soft().m_faces.size(); ++f)
+      faces.push_back({static_cast<int>(world.soft().m_faces[f].m_n[0] - &world.soft().m_nodes[0]),
+                       static_cast<int>(world.soft().m_faces[f].m_n[1] - &world.soft().m_nodes[0]),
+                       static_cast<int>(world.soft().m_faces[f].m_n[2] - &world.soft().m_nodes[0])});
+    test_oracle::RunTally tally;
     auto collision = make_paired_collision(tool, world.soft(), ThinBodyCollisionParams{});
     CollisionStepResult result;
     Eigen::Vector3d direction(unit(rng), unit(rng) - 1.2, unit(rng));  // mostly downward, never from below the ground
@@ -426,16 +453,57 @@ TEST(PairedCollision, RandomPosesVelocitiesAndSpinsKeepTheInvariants) {
       collision->step(previous, current, kStep_s, world.soft(), result);
       const auto nodes = world.node_positions();
       tracker.update(nodes, current);
+      {
+        // The project's answers, item by item, and the oracle's.
+        const Eigen::Isometry3d tool_to_world = to_isometry(current);
+        std::vector<char> cut(faces.size(), 0), inside(nodes.size(), 0);
+        // A triangle whose bounds miss the tool's cannot be cut: it is not clipped (the clip over
+        // the spatula's 1176 planes is this test's main cost). The count over all faces
+        // (triangles_cut_by_volume, through HostSimulation::triangles_cut_by_tool) is checked
+        // against the oracle by the plunge sweep (hold_jitter_test.cpp).
+        for (std::size_t f = 0; f < faces.size(); ++f) {
+          const std::array<Eigen::Vector3d, 3> corner = {current.to_tool(nodes[static_cast<std::size_t>(faces[f][0])]),
+                                                         current.to_tool(nodes[static_cast<std::size_t>(faces[f][1])]),
+                                                         current.to_tool(nodes[static_cast<std::size_t>(faces[f][2])])};
+          Eigen::AlignedBox3d bounds(corner[0]);
+          bounds.extend(corner[1]).extend(corner[2]);
+          if (!bounds.intersects(tool_bounds)) continue;
+          cut[f] = volume.reaches_inside(corner[0], corner[1], corner[2], kInsideToleranceM, clip_scratch) ? 1 : 0;
+        }
+        for (std::size_t i = 0; i < nodes.size(); ++i)
+          inside[i] = -tool.signed_distance_m(current.to_tool(nodes[i])) > test_scene::CrossingTracker::kInsideTolerance_m ? 1 : 0;
+        test_oracle::OracleCounts o = oracle.check(nodes, faces, tool_to_world, false);
+        if (o.cut != cut || o.inside != inside) {
+          o = oracle.check(nodes, faces, tool_to_world, true);  // the answers differ at t: the margins decide
+        } else {
+          o.cut_loose = o.cut_strict = o.cut;  // identical at t: nothing for the margins to decide
+          o.inside_loose = o.inside_strict = o.inside;
+        }
+        const test_oracle::Agreement triangles = test_oracle::compare(cut, o.cut, o.cut_loose, o.cut_strict);
+        tally.add(triangles, test_oracle::compare(inside, o.inside, o.inside_loose, o.inside_strict));
+      }
       finite = finite && result.force_on_tool_world_n.allFinite();
       for (const auto& p : nodes) finite = finite && p.allFinite();
       contact_steps += result.contacted_triangles > 0 ? 1 : 0;
       previous = current;
     }
     runs_with_contact += contact_steps > 0 ? 1 : 0;
+    std::printf("[fuzz] run %2d %-7s %6.2f m/s, %3d steps: cut triangles project max %d on %d steps, oracle max %d on %d steps, "
+                "differ %ld (beyond the margin %ld) | nodes inside project max %d, oracle max %d, differ %ld (beyond %ld)\n",
+                run, run % 2 == 0 ? "plate" : "spatula", speed, tally.steps, tally.project_max_cut, tally.project_steps_with_cut,
+                tally.oracle_max_cut, tally.oracle_steps_with_cut, tally.triangles_differ, tally.triangles_beyond_margin,
+                tally.project_max_inside, tally.oracle_max_inside, tally.nodes_differ, tally.nodes_beyond_margin);
     EXPECT_EQ(tracker.crossed_nodes(), 0) << "run " << run << " speed " << speed;
     EXPECT_LE(tracker.max_penetration_m(), 1e-4) << "run " << run << " speed " << speed;
     EXPECT_TRUE(finite) << "run " << run;
+    EXPECT_EQ(tally.triangles_beyond_margin, 0) << "run " << run << ": the oracle and the clip disagree on cut triangles";
+    EXPECT_EQ(tally.nodes_beyond_margin, 0) << "run " << run << ": the oracle and the tracker disagree on nodes inside";
+    all_runs.triangles_differ += tally.triangles_differ;
+    all_runs.project_steps_with_cut += tally.project_steps_with_cut;
+    all_runs.oracle_steps_with_cut += tally.oracle_steps_with_cut;
   }
+  std::printf("[fuzz] all runs: steps with cut triangles project %d, oracle %d; triangle answers differing within the margin %ld\n",
+              all_runs.project_steps_with_cut, all_runs.oracle_steps_with_cut, all_runs.triangles_differ);
   EXPECT_GE(runs_with_contact, 12) << "the random runs must mostly hit the sphere";
 }
 

@@ -5,12 +5,15 @@
 // pose matching, settled, a tool started above its top, driven down at one speed, then held.
 // Lockstep (simulated time): every figure but the step times is deterministic.
 #include <array>
+#include <functional>
 #include <string_view>
 #include <vector>
 
 #include "fissure/host_sim/scene_description.hpp"
 
 namespace fissure::host {
+
+class HostSimulation;
 
 /// Where the tool's leading face starts above the settled soft surface [m]: 15 mm, clear of
 /// the ball so the first steps are out of contact at every speed.
@@ -80,9 +83,14 @@ struct PlungeHoldResult {
   HoldForceStats hold;
 };
 
+/// Called on every measured hold step with the simulation and that step's cut-triangle count
+/// (count_cut_triangles only): a test checks the count against an independent ruler.
+using HoldStepObserver = std::function<void(HostSimulation& sim, int cut_triangles)>;
+
 /// Settles, plunges the tool kPlungeDepth_m into the ball at `speed_m_s`, holds it
 /// kHoldSettle_s + hold_s, and measures (the cut triangles too when count_cut_triangles).
 [[nodiscard]] PlungeHoldResult run_plunge_hold(const SceneDescription& scene, SceneCollisionMethod method, double speed_m_s,
-                                               double leading_half_m, double hold_s, bool count_cut_triangles = false);
+                                               double leading_half_m, double hold_s, bool count_cut_triangles = false,
+                                               const HoldStepObserver& on_hold_step = {});
 
 }  // namespace fissure::host
