@@ -13,7 +13,6 @@
 #include "fissure/rt_core/proxy_blend.hpp"
 #include "fissure/rt_core/safety.hpp"
 #include "fissure/rt_core/staleness.hpp"
-#include "fissure/rt_core/sub_count_position.hpp"
 #include "fissure/rt_core/velocity_filter.hpp"
 
 namespace fissure::rt {
@@ -56,9 +55,6 @@ std::uint32_t read_device(const RtModel& model, RtData& data, falcon::HapticDevi
     ++data.faults.non_finite;
     return kFaultNonFinite;
   }
-  // The velocity filter starts from rest at its first sample; the sub-count estimate starts
-  // at the reading with it (nothing to predict from).
-  if (!data.velocity.primed) reset(data.sub_count);
   const Eigen::Vector3d v =
       update_velocity(model.velocity_filter, data.velocity, data.kinematics.p_device_m, model.period_s);
   if (!v.allFinite()) {
@@ -150,11 +146,7 @@ TickResult tick(const RtModel& model, RtData& data, TickIo& io, const TickTiming
   Eigen::Vector3d force = Eigen::Vector3d::Zero();
   const double fade_gain = update_fade(config.proxy, data.fade, usable, model.period_s);
   if (data.have_position) {
-    // The contact is evaluated at the sub-count position (no steps of one count at k·50 µm);
-    // the observer and the host keep the readings.
-    const Eigen::Vector3d p_contact_device_m =
-        update_sub_count_position(data.sub_count, data.p_device_m, data.v_device_m_per_s, model.period_s);
-    data.tool = device_to_tool(config.mapping, p_contact_device_m, data.v_device_m_per_s);
+    data.tool = device_to_tool(config.mapping, data.p_device_m, data.v_device_m_per_s);
     Eigen::Vector3d new_force = Eigen::Vector3d::Zero();
     data.max_penetration_m = -1.0;
     data.patches_in_contact = 0;

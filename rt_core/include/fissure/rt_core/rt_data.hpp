@@ -15,7 +15,6 @@
 #include "fissure/rt_core/rt_config.hpp"
 #include "fissure/rt_core/safety.hpp"
 #include "fissure/rt_core/staleness.hpp"
-#include "fissure/rt_core/sub_count_position.hpp"
 #include "fissure/rt_core/velocity_filter.hpp"
 #include "fissure/shared/messages.hpp"
 
@@ -47,9 +46,6 @@ struct RtData {
   Eigen::Vector3d p_device_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d v_device_m_per_s = Eigen::Vector3d::Zero();
   bool have_position = false;               ///< p_device_m came from a good sample this tick
-  /// The reading interpolated below one encoder count (sub_count_position.hpp): where the
-  /// contact force is evaluated.
-  SubCountPositionState sub_count{};
   // Position epoch (messages.hpp, DeviceState::status_flags bits 24..31): advanced at the first
   // accepted sample after one or more rejected ones, and at the very first accepted sample.
   std::uint8_t position_epoch = 0;          ///< epoch of the position published (0: no sample accepted yet)
