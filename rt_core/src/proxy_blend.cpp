@@ -8,6 +8,14 @@ namespace fissure::rt {
 void begin_swap(BlendState& state, const Eigen::Vector3d& old_force_device_n,
                 const Eigen::Vector3d& new_force_device_n) noexcept {
   state.offset_device_n += old_force_device_n - new_force_device_n;
+  state.offset_held = false;
+}
+
+void continue_after_break(BlendState& state, const Eigen::Vector3d& force_in_use_device_n) noexcept {
+  // The last output already holds every earlier offset: it replaces them.
+  if (!state.have_last_output) return;
+  state.offset_device_n = state.last_output_device_n - force_in_use_device_n;
+  state.offset_held = true;
 }
 
 double blend_walk_n(const Eigen::Vector3d& motion_step_n, const Eigen::Vector3d& offset_unit, double offset_norm_n,
@@ -23,7 +31,7 @@ double blend_walk_n(const Eigen::Vector3d& motion_step_n, const Eigen::Vector3d&
 
 Eigen::Vector3d blend(BlendState& state, const Eigen::Vector3d& new_force_device_n, double max_step_n) noexcept {
   const double remaining = state.offset_device_n.norm();
-  if (remaining > 0.0) {
+  if (remaining > 0.0 && !state.offset_held) {
     // Before the walk the output would be new_force + offset: its step from the last output is
     // the tool's motion under the proxy in use (at a swap: under the old one, begin_swap having
     // made new + offset = old at this pose).

@@ -161,7 +161,11 @@ TickResult tick(const RtModel& model, RtData& data, TickIo& io, const TickTiming
       stored_energy_j = fade_gain * data.safety.ramp_gain * model.device_energy_per_world_energy *
                         evaluation.stored_energy_world_j;
     }
-    if (intake == ProxyIntake::kAccepted) {
+    if (history_break) {
+      // A proxy accepted in this tick is the one in use: the force it gives here is what the
+      // blend walks to; the one it replaces is as stale as the rest (proxy_blend.hpp).
+      continue_after_break(data.blend, new_force);
+    } else if (intake == ProxyIntake::kAccepted) {
       Eigen::Vector3d old_force = Eigen::Vector3d::Zero();  // the first proxy blends in from zero
       if (data.proxy.have_previous) {
         evaluate_proxy(previous_proxy(data.proxy), config.mapping, data.tool, data.part_forces, model.damping_cap);

@@ -264,6 +264,55 @@ TEST(RtLoop, AHandRestingOnAStiffWallAfterAnImpactGetsTheWallsForceWithin100ms) 
   EXPECT_LE(on.max_observed_energy_j, 0.005);
 }
 
+// Issue 26: the rt loop stalls for 100 ms (the clock jumps; SimFalcon integrates the gap under
+// the last command) while the hand, resting on a 1000 N/m wall, starts a 10 mm press. The proxy
+// in use was built before the stall: evaluated at the pose after it, it gives ~10 N no contact
+// produced, and the host's first proxy after the stall sees no contact (as the rt-stall stress
+// case's host did after the tool's jump), the one after it the wall again. The contact force
+// goes on from what the device held through the stall (proxy_blend.hpp, continue_after_break)
+// instead of from the stale proxy at the new pose.
+TEST(RtLoop, AfterAStallTheContactForceGoesOnFromWhatTheDeviceHeld) {
+  constexpr double kWall_n_per_m = 1000.0, kWallY_m = -0.004;
+  falcon::SimFalconConfig sim;
+  HandScript hand;
+  hand.start_position_device_m = {0.0, 0.0, kCentreZ_m};
+  hand.waypoints.push_back({{0.0, 0.0, kCentreZ_m}, 0.05, 0.6});                // ramp-in
+  hand.waypoints.push_back({{0.0, kWallY_m - 0.006, kCentreZ_m}, 0.05, 0.5});   // rest 6 mm in
+  hand.waypoints.push_back({{0.0, kWallY_m - 0.016, kCentreZ_m}, 0.1, 1.0});    // press 10 mm more
+  hand.release_at_end = false;
+  sim.hand = hand;
+  Session s(RtConfig{}, sim);
+  // The rest begins at 0.8 s and ends at 1.3 s: the stall covers the first 0.1 s of the press,
+  // and the host's first 20 ms of proxies after it see no contact.
+  constexpr double kStallStart_s = 1.3, kStall_s = 0.1, kNoContactUntil_s = kStallStart_s + kStall_s + 0.02;
+  bool stalled = false;
+  double before_n = 0.0, after_max_n = 0.0;
+  TelemetrySample sample;
+  for (int k = 0; k < 1600; ++k) {
+    const double t_s = to_seconds(s.clock.now());
+    const bool no_contact = stalled && t_s < kNoContactUntil_s;
+    const double plane_y_m = no_contact ? -0.5 : kWallY_m;  // -0.5 m: far below the tool
+    s.proxy_in.publish(plane_proxy(static_cast<std::uint64_t>(k + 1), {0.0, plane_y_m, 0.0}, {0.0, 1.0, 0.0}, kWall_n_per_m));
+    if (!stalled && t_s >= kStallStart_s) {
+      s.clock.advance(static_cast<TimeNs>(kStall_s * 1e9));
+      stalled = true;
+    }
+    s.loop->step();
+    while (s.telemetry->try_pop(sample)) {
+      const double sample_t_s = to_seconds(sample.time_ns);
+      const double contact_n = Eigen::Vector3d(sample.contact_force_device_n[0], sample.contact_force_device_n[1],
+                                               sample.contact_force_device_n[2]).norm();
+      if (sample_t_s < kStallStart_s) before_n = contact_n;
+      if (sample_t_s >= kStallStart_s && sample_t_s < kNoContactUntil_s) after_max_n = std::max(after_max_n, contact_n);
+    }
+  }
+  ASSERT_TRUE(stalled);
+  EXPECT_GT(before_n, 1.0);  // resting 6 mm into the wall against the 300 N/m grip: ≈ 1.4 N
+  // What the device held, plus the wall's stiffness over the first tick's motion (≤ 0.1 N at
+  // 0.1 m/s): not the ~10 N of the old plane 10 mm deeper.
+  EXPECT_LE(after_max_n, before_n + 0.2);
+}
+
 // A device whose exchange takes 2.5 periods of (lockstep) time.
 class SlowDevice final : public falcon::HapticDevice {
  public:

@@ -29,6 +29,9 @@ struct BlendState {
   /// the motion step m is measured from.
   Eigen::Vector3d last_output_device_n = Eigen::Vector3d::Zero();
   bool have_last_output = false;
+  /// Set by continue_after_break until the next swap: the offset holds instead of walking
+  /// towards the force of a proxy built before the break.
+  bool offset_held = false;
 };
 
 /// Call on the tick a new proxy is accepted, with both proxies' forces at the current position.
@@ -38,7 +41,19 @@ void begin_swap(BlendState& state, const Eigen::Vector3d& old_force_device_n,
 /// Drops what is left of the swap offsets: the force they stood for no longer applies (the
 /// old proxies were built for a tool pose lost in a device fault; the tick calls this while
 /// one is latched and safety's ramp-in brings the force back continuously instead).
-inline void cancel_swaps(BlendState& state) noexcept { state.offset_device_n.setZero(); }
+inline void cancel_swaps(BlendState& state) noexcept {
+  state.offset_device_n.setZero();
+  state.offset_held = false;
+}
+/// After a break in the motion history (the loop stalled while the device kept its last
+/// command, tick.cpp): the proxies on hand were built for a pose the tool has since left, and
+/// evaluated at the new pose they give a force no contact produces — their planes extend far
+/// past the contact they stood for (rt-stall stress case: 6 N at a pose 8 mm away, against the
+/// 1.7 N the device held through the stall, and the next proxy saw no contact there). The blend
+/// goes on from the force it last rendered instead: the difference to the proxy in use is the
+/// offset, held until the next proxy is accepted (walking it would head for the stale force)
+/// and walked out from then on as at a swap, so what the hand feels is continuous with the stall.
+void continue_after_break(BlendState& state, const Eigen::Vector3d& force_in_use_device_n) noexcept;
 
 /// The length of this tick's walk of an offset along unit direction −offset_unit, given the
 /// motion step m: the largest s ∈ [0, min(|offset|, max_step_n)] with
