@@ -182,8 +182,7 @@ void bind_host(py::module_& m) {
                              "int32 (-1: none), tool_plane (C,) int32, jaw (C,) int32, point_world_m (C, 3) [m] (triangle\n"
                              "centroid after the response), normal_world (C, 3) (tool face outward normal), penetration_m (C,)\n"
                              "[m] (Hunt-Crossley deformation x), penetration_rate_m_s (C,) [m/s], weight (C,) (contacted rest\n"
-                             "area [m²] in per-unit-area mode), force_n (C,) [N] (the triangle's HC force magnitude).\n"
-                             "Empty for the bullet method (Bullet's own contacts are not ContactRecords).")
+                             "area [m²] in per-unit-area mode), force_n (C,) [N] (the triangle's HC force magnitude).")
       .def_property_readonly("crossed_nodes", [](const StepResult& s) { return s.result.crossing.crossed_nodes; },
                              "soft nodes that went through the tool (wrong side ∪ through ∪ inside; target 0)")
       .def_property_readonly("wrong_side_nodes", [](const StepResult& s) { return s.result.crossing.wrong_side_nodes; })

@@ -5,6 +5,7 @@
 // (outside the reachable region, FK not converged) gives NaN in its row rather than an exception.
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
+#include <pybind11/stl.h>
 
 #include <cmath>
 #include <limits>
@@ -121,7 +122,7 @@ void bind_kinematics(py::module_& m) {
         bool* flags = out.mutable_data();
         for (py::ssize_t i = 0; i < n; ++i) flags[i] = falcon::in_workspace(geometry, Eigen::Vector3d(in[3 * i], in[3 * i + 1], in[3 * i + 2]));
         if (single) return py::bool_(flags[0]);
-        return std::move(out);
+        return out;
       },
       py::arg("p_device_m"),
       "Inside the documented workspace ball (WORKSPACE_RADIUS_M around WORKSPACE_CENTRE_DEVICE_M) and reachable.\n"

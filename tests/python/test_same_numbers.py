@@ -22,8 +22,8 @@ def _hex_rows(rows):
     return [[float.fromhex(v) for v in row] for row in rows]
 
 
-@pytest.mark.parametrize("scene_name,method,steps", [("spatula-sphere", "paired", 450), ("clamp-sphere", "paired", 200),
-                                                     ("spatula-sphere", "bullet", 200)])
+@pytest.mark.parametrize("scene_name,method,steps", [("spatula-sphere", "paired", 450), ("clamp-sphere", "paired", 1300),
+                                                     ("spatula-sphere", "bullet", 500)])
 def test_host_steps_bit_for_bit(host_reference, scene_name, method, steps):
     settle_s = 0.2
     ref = _reference(host_reference, "host", scene_name, method, str(settle_s), str(steps))
@@ -73,7 +73,7 @@ def test_session_matches_the_command_line(fissure_bin, tmp_path):
     trace = result.trace
     assert list(trace) == list(fissure.TRACE_COLUMNS)
     assert trace["tick"].dtype == np.int64 and trace["force_n"].dtype == np.float64
-    assert len(trace["time_s"]) == result.summary["ticks"] == 800
+    assert len(trace["time_s"]) == result.summary["ticks"] > 0
     assert trace["force_n"].max() == pytest.approx(result.summary["force_max_n"], rel=1e-5)
     assert trace["host_force_n"].max() > 0.1, "the session must reach contact"
 
@@ -85,9 +85,12 @@ def test_stress_case_matches_the_command_line(fissure_bin, tmp_path):
     cli = json.loads(report_path.read_text())
     py = fissure.stress(cases=[case], jobs=1)
     assert set(py) == set(cli)
-    assert len(py["rows"]) == 1
-    cli_row, py_row = cli["rows"][0], py["rows"][0]
+    for key in ("base_seed", "failed", "known_failures", "profile", "energy_bound_j", "recovery_bound_s"):
+        assert py[key] == cli[key], key
+    assert len(py["cases"]) == 1
+    cli_row, py_row = cli["cases"][0], py["cases"][0]
+    assert py_row["name"] == case and py_row["ticks"] > 0
     assert set(py_row) == set(cli_row)
     for key in cli_row:
-        if key != "wall_s":
+        if key != "wall_s":  # the only wall-clock figure of a lockstep case
             assert py_row[key] == cli_row[key], key
