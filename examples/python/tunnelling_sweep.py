@@ -6,7 +6,7 @@ tool is driven 20 mm into it at each speed and held; the method-independent metr
 soft nodes that went through the tool and the deepest node inside it. Lockstep (simulated time):
 every plotted figure is deterministic.
 
-    PYTHONPATH=build/python python3 examples/python/tunnelling_sweep.py [--tool blade_edge_first] [--quick]
+    PYTHONPATH=build/python python3 examples/python/tunnelling_sweep.py [--tool plate_1mm] [--quick]
 """
 import argparse
 import os
@@ -54,7 +54,7 @@ def plot(tool, speeds, rows, png):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     names = [t["name"] for t in fissure.plunge_tools()]
-    parser.add_argument("--tool", default="blade_edge_first", choices=names)
+    parser.add_argument("--tool", default="plate_1mm", choices=names)
     parser.add_argument("--quick", action="store_true", help="three speeds and a short hold (CI)")
     parser.add_argument("--out", default="out/python/tunnelling_sweep.png", help="PNG to write")
     args = parser.parse_args(argv)

@@ -24,7 +24,11 @@ def test_tunnelling_sweep(source_dir, tmp_path):
     out = _run_example(source_dir, "tunnelling_sweep.py", tmp_path / "sweep.png")
     rows = re.findall(r"^(\S+)\s+(paired|bullet)\s+([\d.]+) m/s\s+crossed\s+(\d+)", out, re.M)
     assert len(rows) == 6, out
-    assert all(int(crossed) == 0 for _, method, _, crossed in rows if method == "paired"), out
+    crossed = {(method, float(speed)): int(n) for _, method, speed, n in rows}
+    # The figure's point (issue 5, docs/benchmarks.md): the paired collision lets no node through the
+    # 1 mm plate at any speed; Bullet's own does at 20 m/s.
+    assert all(n == 0 for (method, _), n in crossed.items() if method == "paired"), out
+    assert crossed[("bullet", 20.0)] > 0, out
 
 
 def test_force_indentation(source_dir, tmp_path):
