@@ -6,8 +6,9 @@ and Debian's python3 (the one toolchain/setup.sh installs NumPy and matplotlib f
     import fissure
     sim = fissure.HostSimulation(fissure.Scene.load("spatula-sphere"))
     sim.settle(1.0)
-    for y in (0.110, 0.100, 0.095):
-        print(sim.step([0.0, y, 0.0]).force)      # N, world frame
+    for i in range(500):                          # the tool down at 5 cm/s [m, world]
+        r = sim.step([0.0, 0.12 - 0.05e-3 * i, 0.0])
+    print(r.force, r.contact_count, r.crossed_nodes)  # force on the tool [N, world]
 
 Units are SI (m, s, N, rad) and every array says its frame: world = Bullet's (y up), tool =
 the tool's own (thin axis y), device = the Falcon's (libnifalcon's: x right, y up, z towards
@@ -23,8 +24,15 @@ What is here:
   fk, ik, jacobian, in_workspace    Falcon kinematics (one point or a batch)
 """
 import os as _os
+import sys as _sys
 
 from . import _paths
+
+try:
+    import numpy as _numpy  # noqa: F401  (the compiled module needs it; say so plainly when it is missing)
+except ImportError as _error:
+    raise ImportError(f"fissure needs NumPy, which {_sys.executable} does not have; the module was built for "
+                      f"{_paths.PYTHON_EXECUTABLE} (toolchain/setup.sh installs python3-numpy for it)") from _error
 
 # Scene names ("spatula-sphere") and the session plot script resolve from any working directory.
 _os.environ.setdefault("FISSURE_SCENES_DIR", _paths.SCENES_DIR)

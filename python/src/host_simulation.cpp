@@ -230,8 +230,9 @@ void bind_host(py::module_& m) {
                                "Typical use:\n"
                                "    sim = fissure.HostSimulation(fissure.Scene.load('spatula-sphere'))\n"
                                "    sim.settle(1.0)\n"
-                               "    r = sim.step([0.0, 0.095, 0.0])   # tool target position [m, world]\n"
-                               "    print(r.force, r.crossed_nodes)")
+                               "    for i in range(500):               # down at 5 cm/s: 0.05 mm per 1 ms step\n"
+                               "        r = sim.step([0.0, 0.12 - 0.05e-3 * i, 0.0])   # tool target [m, world]\n"
+                               "    print(r.force, r.crossed_nodes)    # force on the tool [N, world]; 0")
       .def(py::init<const SceneDescription&, const std::optional<std::string>&, bool>(), py::arg("scene"), py::arg("method") = py::none(),
            py::arg("solver_node_bounds") = true,
            "method: 'paired', 'ray' or 'bullet' (None: the scene's). solver_node_bounds=False: Bullet's stock soft\n"
