@@ -46,7 +46,6 @@ def main(argv=None):
     ax_cost.axvline(oracle["host_cpu_s_per_s"] * 1e3, color="grey", ls=":", lw=0.8, label=f"oracle ({oracle['host_hz']:.0f} Hz)")
     ax_cost.set_xlabel("host CPU per simulated second [ms/s]")
     ax_cost.set_ylabel("rendered force error [% of oracle peak]")
-    ax_cost.set_xscale("log")
     ax_cost.legend()
     ax_rate.plot([r["host_hz"] for r in rows], [r["rms_error_pct"] for r in rows], "o-", label="RMS error")
     ax_rate.set_xscale("log")
