@@ -17,6 +17,8 @@ packages=(
   libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libglfw3-dev libpng-dev  # viewer/: headless EGL (llvmpipe), GL 3.3, GLFW window, PNG
   # session plot (Debian's interpreter, not whatever python3 is first on PATH)
   python3 python3-matplotlib
+  # the fissure Python module (python/) and its tests: pybind11 against Debian's python3, NumPy, pytest
+  python3-dev pybind11-dev python3-numpy python3-pytest
   # cyclictest, the OS-latency reference of `fissure bench rt`
   rt-tests
 )
