@@ -54,7 +54,7 @@ void run(const RunOptions& options) {
   } catch (const std::exception& e) {
     throw CommandError(e.what());
   }
-  if (!options.method.empty()) scene.collision_method = *host::parse_collision_method(options.method);
+  if (!options.method.empty()) scene.simulation.collision_method = *host::parse_collision_method(options.method);
   SessionOptions session;
   session.scene = scene;
   session.record_path = options.record_path;

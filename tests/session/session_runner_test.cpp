@@ -212,7 +212,7 @@ TEST_F(SessionRunnerTest, AReplayRunsAtAnotherRateHostRateAndMethod) {
   replay.duration_s = 0.0;
   replay.rt_rate_hz = 2000.0;
   replay.host_rate_hz = 500.0;
-  replay.scene.collision_method = host::SceneCollisionMethod::kRay;
+  replay.scene.simulation.collision_method = host::SceneCollisionMethod::kRay;
   replay.out_dir = out_ / "replayed";
   const SessionOutcome outcome = run_session(replay);
   const nlohmann::json& r = outcome.summary["replay"];

@@ -125,15 +125,15 @@ TEST(SessionFingerprint, CoversTheSceneNameAndEveryMappingField) {
   EXPECT_EQ(std::string(long_name.scene_name.data()).size(), kHelloSceneNameBytes - 1) << "cut, and terminated";
 }
 
-/// Runs two endpoints until both are established or one failed; bounded, no sleeps.
+/// Runs two endpoints until both are established or both refused the other; bounded, no sleeps.
 template <typename Pump>
 void link_up(transport::LinkEndpoint& a, transport::LinkEndpoint& b, Pump&& between) {
   for (int i = 0; i < 100'000; ++i) {
     a.tick();
     b.tick();
     between();
-    const bool failed = a.handshake().state() == HandshakeState::kFailed || b.handshake().state() == HandshakeState::kFailed;
-    if (failed || (a.established() && b.established() && a.handshake().peer_acknowledged() && b.handshake().peer_acknowledged())) return;
+    const bool both_refused = a.handshake().state() == HandshakeState::kFailed && b.handshake().state() == HandshakeState::kFailed;
+    if (both_refused || (a.established() && b.established() && a.handshake().peer_acknowledged() && b.handshake().peer_acknowledged())) return;
   }
 }
 
@@ -172,11 +172,6 @@ TEST(Handshake, AnotherSceneIsRefusedAtBothEndsNamingBothInProcess) {
   transport::LinkEndpoint rt(link.a(), clock, end_config(Role::kRt, 1, "clamp-vessel", clamp_mapping()));
   transport::LinkEndpoint host(link.b(), clock, end_config(Role::kHost, 2, "spatula-sphere", DeviceMapping{}));
   link_up(rt, host, [&] { clock.advance(1'000'000); });
-  for (int i = 0; i < 1000 && rt.handshake().state() != HandshakeState::kFailed; ++i) {  // the other end judges in its next ticks
-    rt.tick();
-    host.tick();
-    clock.advance(1'000'000);
-  }
   expect_session_mismatch(rt, "rt runs scene 'clamp-vessel'", "host", "spatula-sphere");
   expect_session_mismatch(host, "host runs scene 'spatula-sphere'", "rt", "clamp-vessel");
   // Data from a refused peer is never accepted.
@@ -227,12 +222,6 @@ TEST(Handshake, OverUdpTheMatchLinksAndTheMismatchIsRefused) {
       EXPECT_TRUE(rt.established());
       EXPECT_TRUE(host.established());
     } else {
-      for (int i = 0; i < 100'000 && (host.handshake().state() != HandshakeState::kFailed ||
-                                       rt.handshake().state() != HandshakeState::kFailed); ++i) {
-        rt.tick();
-        host.tick();
-        clock.advance(1'000'000);  // a refused end repeats its Hello each hello period
-      }
       expect_session_mismatch(rt, "rt runs scene 'clamp-vessel'", "host", "spatula-sphere");
       expect_session_mismatch(host, "host runs scene 'spatula-sphere'", "rt", "clamp-vessel");
     }
