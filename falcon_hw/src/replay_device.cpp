@@ -7,11 +7,7 @@ namespace fissure::falcon {
 ReplayDevice::ReplayDevice(const DeviceRecording& recording, const Clock& clock)
     : recording_(recording), clock_(clock), start_ns_(clock.now()) {
   if (recording.exchanges.empty()) throw RecordingError("the device recording holds no exchanges: nothing to replay");
-  TimeNs longest_interval_ns = 0;
-  for (std::size_t i = 1; i < recording.exchanges.size(); ++i) {
-    longest_interval_ns = std::max(longest_interval_ns, recording.exchanges[i].exchange_time_ns - recording.exchanges[i - 1].exchange_time_ns);
-  }
-  end_ns_ = recording.exchanges.back().exchange_time_ns + longest_interval_ns;
+  end_ns_ = recording.exchanges.back().exchange_time_ns + kHoldAfterEnd_ns;
 }
 
 IoStatus ReplayDevice::try_exchange(const DeviceCommand& command, DeviceReading& reading) noexcept {
@@ -19,8 +15,10 @@ IoStatus ReplayDevice::try_exchange(const DeviceCommand& command, DeviceReading&
   const TimeNs now_ns = clock_.now();
   const TimeNs t_ns = now_ns - start_ns_;
   const auto& exchanges = recording_.exchanges;
-  while (next_ < exchanges.size() && exchanges[next_].exchange_time_ns <= t_ns) ++next_;
-  if (next_ == 0) return IoStatus::kTimeout;
+  // Records older than now are passed over; of those at exactly now, this exchange takes one.
+  while (next_ < exchanges.size() && exchanges[next_].exchange_time_ns < t_ns) ++next_;
+  if (next_ < exchanges.size() && exchanges[next_].exchange_time_ns == t_ns) ++next_;
+  if (next_ == 0) next_ = 1;  // before the first record: its answer (see the header)
   if (next_ == exchanges.size() && t_ns > end_ns_) {
     ++counters_.after_end;
     return IoStatus::kDisconnected;

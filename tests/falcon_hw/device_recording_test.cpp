@@ -178,9 +178,34 @@ TEST_F(DeviceRecordingTest, ReplayAtAnotherRateHoldsTheLatestRecordAndEndsDiscon
   }
   EXPECT_EQ(replay.counters().records_used, kTicks);
   DeviceReading reading;
-  clock.advance(2 * kTick_ns);  // past the last record by more than the recording's interval
+  clock.advance(ReplayDevice::kHoldAfterEnd_ns + kTick_ns);  // past the last record by more than the hold
   EXPECT_EQ(replay.try_exchange(DeviceCommand{}, reading), IoStatus::kDisconnected);
   EXPECT_EQ(replay.counters().after_end, 1);
+}
+
+TEST_F(DeviceRecordingTest, RecordsOfTheSameTimeAreTakenOneExchangeEach) {
+  // The lockstep session's last tick and the zero command after the loop stopped share a time.
+  DeviceRecording recording;
+  for (const TimeNs t : {0, 1'000'000, 1'000'000}) {
+    RecordedExchange x;
+    x.exchange_time_ns = t;
+    DeviceReading r;
+    r.encoder_counts = {static_cast<std::int16_t>(recording.exchanges.size()), 0, 0};
+    x.reply = encode_reading(r);
+    recording.exchanges.push_back(x);
+  }
+  LockstepClock clock(0);
+  ReplayDevice replay(recording, clock);
+  DeviceReading reading;
+  ASSERT_EQ(replay.try_exchange(DeviceCommand{}, reading), IoStatus::kOk);
+  EXPECT_EQ(reading.encoder_counts[0], 0);
+  clock.advance(kTick_ns);
+  ASSERT_EQ(replay.try_exchange(DeviceCommand{}, reading), IoStatus::kOk);
+  EXPECT_EQ(reading.encoder_counts[0], 1);
+  ASSERT_EQ(replay.try_exchange(DeviceCommand{}, reading), IoStatus::kOk);
+  EXPECT_EQ(reading.encoder_counts[0], 2) << "the second exchange at the same time takes the next record";
+  ASSERT_EQ(replay.try_exchange(DeviceCommand{}, reading), IoStatus::kOk);
+  EXPECT_EQ(reading.encoder_counts[0], 2) << "then holds it";
 }
 
 TEST_F(DeviceRecordingTest, RecordedFaultsReplayAsFaults) {

@@ -222,7 +222,7 @@ TEST_F(SessionRunnerTest, AReplayRunsAtAnotherRateHostRateAndMethod) {
   EXPECT_EQ(r["records_used"], r["records"]);
   EXPECT_NEAR(r["exchanges"].get<double>(), 2.0 * r["records"].get<double>(), 2.0);
   EXPECT_EQ(r["exchanges_after_end"].get<int>(), 0);
-  EXPECT_EQ(outcome.summary["faults"].get<int>(), 0);
+  EXPECT_EQ(outcome.summary["faults"].get<int>(), 0) << outcome.summary.dump(1);
 }
 
 TEST_F(SessionRunnerTest, AReplayThatCannotWorkIsRefusedBeforeTouchingEarlierOutputs) {

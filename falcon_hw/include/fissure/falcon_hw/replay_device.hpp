@@ -5,11 +5,16 @@
 // replayed session commands (the recorded hand answered the recorded forces).
 //
 // Each exchange answers with the latest record whose time is at or before clock.now() (both
-// counted from construction), so any rt rate and any clock replay the same motion: on a
-// LockstepClock at the recorded rate every tick gets its own recorded exchange and the session
-// is reproduced exactly. Before the first record the device has not answered (kTimeout);
-// more than the recording's longest exchange interval after the last record the recording
-// has ended and the device reads as disconnected (rt_core fades the force to zero).
+// counted from construction), so any rt rate and any clock replay the same motion. Records
+// are consumed in order: of several with the same time (a tick's exchange and the zero command
+// sent after the loop stopped) each exchange at that time takes the next one. So on a
+// LockstepClock at the recorded rate every exchange gets its own recorded exchange and the
+// session is reproduced exactly. Before the first record's time it answers with the first
+// record (a replay at a higher rate ticks before the recorded session's first tick, which
+// lockstep takes one period after the start); after the last one it holds the last answer for
+// kHoldAfterEnd_ns (a replay at
+// another host rate stops up to a host step after the recorded session), then reads as
+// disconnected (rt_core zeroes the force).
 // try_exchange() is noexcept, allocation-free and O(1) amortised.
 #include <cstdint>
 
@@ -30,6 +35,10 @@ struct ReplayCounters {
 
 class ReplayDevice final : public HapticDevice {
  public:
+  /// How long past the last record the last answer is held [ns]: longer than any host step
+  /// (the scenes' time_step_s is at most 0.1 s) by a margin, far shorter than a session.
+  static constexpr TimeNs kHoldAfterEnd_ns = 250'000'000;
+
   /// `recording` and `clock` must outlive the ReplayDevice. Throws RecordingError for a
   /// recording without exchanges.
   ReplayDevice(const DeviceRecording& recording, const Clock& clock);
@@ -43,7 +52,7 @@ class ReplayDevice final : public HapticDevice {
   const DeviceRecording& recording_;
   const Clock& clock_;
   TimeNs start_ns_;
-  TimeNs end_ns_;            ///< last record's time + the longest interval between records
+  TimeNs end_ns_;            ///< last record's time + kHoldAfterEnd_ns
   std::size_t next_ = 0;     ///< first record after the current one
   std::size_t last_used_ = 0;
   ReplayCounters counters_;
