@@ -103,6 +103,10 @@ HandshakeEvent Handshake::on_hello(const Hello& peer) noexcept {
     return event;
   }
   if (identity_.fingerprint != 0 && peer.session_fingerprint != 0 && peer.session_fingerprint != identity_.fingerprint) {
+    // Answer the first refusal of a peer session at once: the peer needs our Hello to refuse us
+    // too (and name both scenes) before it gives up, and an end that stops after a refusal may
+    // be gone before its next periodic Hello. Only once, so two refusing ends do not ping-pong.
+    event.reply_needed = error_ != HandshakeError::kSessionMismatch || event.peer_restarted;
     state_ = HandshakeState::kFailed;
     error_ = HandshakeError::kSessionMismatch;
     std::snprintf(error_message_.data(), error_message_.size(),

@@ -192,6 +192,17 @@ TEST(Handshake, SameSceneWithAnotherMappingIsRefused) {
   expect_session_mismatch(rt, "rt runs scene 'clamp-vessel'", "host", "clamp-vessel");
 }
 
+TEST(Handshake, ARefusalIsAnsweredOnceSoThePeerCanRefuseToo) {
+  Handshake rt(Role::kRt, 1000.0f, 1, session_identity("clamp-vessel", clamp_mapping()));
+  Hello peer = hello_from(Role::kHost, kProtocolVersion, 2);
+  peer.session_fingerprint = session_fingerprint("spatula-sphere", DeviceMapping{});
+  EXPECT_TRUE(rt.on_hello(peer).reply_needed) << "the host must get our Hello to refuse us";
+  EXPECT_FALSE(rt.on_hello(peer).reply_needed) << "not again for the same host session";
+  peer.session_id = 3;
+  EXPECT_TRUE(rt.on_hello(peer).reply_needed) << "a restarted host is answered again";
+  EXPECT_EQ(rt.state(), HandshakeState::kFailed);
+}
+
 TEST(Handshake, AnEndWithoutAFingerprintIsNotChecked) {
   Handshake rt(Role::kRt, 1000.0f, 1, session_identity("clamp-vessel", clamp_mapping()));
   Hello peer = hello_from(Role::kHost, kProtocolVersion, 2);
