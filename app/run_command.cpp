@@ -42,6 +42,9 @@ struct RunOptions {
   int frame_every = 10;
   int width_px = 960;
   int height_px = 720;
+  std::string method;
+  std::string record_path;
+  std::string replay_path;
 };
 
 void run(const RunOptions& options) {
@@ -51,8 +54,11 @@ void run(const RunOptions& options) {
   } catch (const std::exception& e) {
     throw CommandError(e.what());
   }
+  if (!options.method.empty()) scene.simulation.collision_method = *host::parse_collision_method(options.method);
   SessionOptions session;
   session.scene = scene;
+  session.record_path = options.record_path;
+  session.replay_path = options.replay_path;
   session.device = options.device == "usb" ? SessionDevice::kUsb : SessionDevice::kSim;
   session.lockstep = options.lockstep;
   session.duration_s = options.duration_s;
@@ -103,6 +109,17 @@ void run(const RunOptions& options) {
                   v["capture_publish_us"]["median"].get<double>());
     }
   }
+  if (s.contains("replay")) {
+    const nlohmann::json& r = s["replay"];
+    std::printf("  replayed %s (recorded from %s on '%s'): %llu records, %llu exchanges, %llu commands differing from the recorded ones\n",
+                r["file"].get<std::string>().c_str(), r["recorded_device"].get<std::string>().c_str(),
+                r["recorded_scene"].get<std::string>().c_str(), r["records"].get<unsigned long long>(),
+                r["exchanges"].get<unsigned long long>(), r["commands_differing"].get<unsigned long long>());
+  }
+  if (s.contains("recording")) {
+    std::printf("  recorded %llu device exchanges to %s\n", s["recording"]["exchanges"].get<unsigned long long>(),
+                s["recording"]["file"].get<std::string>().c_str());
+  }
   std::printf("  wrote %s, %s%s%s\n", outcome.trace_path.c_str(), outcome.summary_path.c_str(),
               outcome.plot_path.empty() ? "" : ", ", outcome.plot_path.c_str());
 }
@@ -116,6 +133,12 @@ void register_run(CommandTree& tree) {
   cmd->add_option("scene", options->scene, "scene name (scenes/NAME.toml) or path to a scene file")->required();
   cmd->add_option("--device", options->device, "sim (SimFalcon with the scene's hand script) or usb (the real Falcon)")
       ->check(CLI::IsMember({"sim", "usb"}));
+  cmd->add_option("--method", options->method, "collision method: paired | ray | bullet (default: the scene's)")
+      ->check(CLI::IsMember({"paired", "ray", "bullet"}));
+  cmd->add_option("--record", options->record_path,
+                  "keep every device exchange (encoder counts, buttons, timestamps as Falcon packets) in FILE, for --replay");
+  cmd->add_option("--replay", options->replay_path,
+                  "the device answers from a recording made with --record (any --rate, --method, --host-rate; --lockstep reproduces it)");
   cmd->add_flag("--lockstep", options->lockstep, "simulated time: deterministic, as fast as the CPU allows");
   cmd->add_option("--duration", options->duration_s, "seconds, at most 86400 (default: the hand script's length; usb: until Ctrl-C)")
       ->check(CLI::Validator([](std::string& text) { return check_seconds_at_most(text, 86400.0, "one day per session"); }, "0..86400"));

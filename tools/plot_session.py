@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Plot a `fissure run` trace: force, penetration and proxy age against time.
+"""Plot a `fissure run` trace: force, penetration, proxy age and, for a clamp, the jaw gap against time.
 
 usage: plot_session.py TRACE.csv OUT.png [--title TEXT]
 Uses only the standard library's csv module and matplotlib (Debian's python3-matplotlib).
@@ -13,25 +13,35 @@ import matplotlib
 matplotlib.use("Agg")  # headless: CI and SSH sessions have no display
 import matplotlib.pyplot as plt  # noqa: E402
 
+REQUIRED_COLUMNS = ["time_s", "force_n", "contact_force_n", "host_force_n", "penetration_m",
+                    "host_penetration_m", "proxy_age_ms"]
+# Traces written before the jaw gap was recorded have no such column: they plot without it.
+OPTIONAL_COLUMNS = ["host_jaw_gap_m"]
 
-def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("trace")
-    parser.add_argument("png")
-    parser.add_argument("--title", default="")
-    args = parser.parse_args()
 
-    columns = {"time_s": [], "force_n": [], "contact_force_n": [], "host_force_n": [],
-               "penetration_m": [], "host_penetration_m": [], "proxy_age_ms": []}
-    with open(args.trace, newline="") as f:
-        for row in csv.DictReader(f):
+def read_trace(path):
+    columns = {key: [] for key in REQUIRED_COLUMNS}
+    with open(path, newline="") as f:
+        reader = csv.DictReader(f)
+        present = [key for key in OPTIONAL_COLUMNS if key in (reader.fieldnames or [])]
+        for key in present:
+            columns[key] = []
+        for row in reader:
             for key, values in columns.items():
                 values.append(float(row[key]))
-    if not columns["time_s"]:
-        print(f"plot_session.py: {args.trace} has no samples", file=sys.stderr)
-        return 1
+    return columns
+
+
+def is_clamp(columns):
+    """A clamp session: the host applied a jaw gap (0 for every other tool)."""
+    return any(v > 0.0 for v in columns.get("host_jaw_gap_m", []))
+
+
+def build_figure(columns, title=""):
     t = columns["time_s"]
-    fig, axes = plt.subplots(3, 1, sharex=True, figsize=(9, 7.5))
+    clamp = is_clamp(columns)
+    rows = 4 if clamp else 3
+    fig, axes = plt.subplots(rows, 1, sharex=True, figsize=(9, 2.5 * rows))
     axes[0].plot(t, columns["force_n"], label="commanded |F| (device)", lw=1.0)
     axes[0].plot(t, columns["contact_force_n"], label="proxy |F| (before safety)", lw=0.8, ls="--")
     axes[0].plot(t, columns["host_force_n"], label="host |F| (last host step)", lw=0.8, alpha=0.7)
@@ -43,13 +53,30 @@ def main() -> int:
     axes[1].legend(loc="upper right", fontsize="small")
     axes[2].plot(t, columns["proxy_age_ms"], lw=0.8)
     axes[2].set_ylabel("proxy age [ms]")
-    axes[2].set_xlabel("time [s]")
+    if clamp:
+        axes[3].plot(t, [1e3 * v for v in columns["host_jaw_gap_m"]], lw=1.0, label="gap between the jaws (host)")
+        axes[3].set_ylabel("jaw gap [mm]")
+        axes[3].legend(loc="upper right", fontsize="small")
+    axes[-1].set_xlabel("time [s]")
     for ax in axes:
         ax.grid(True, alpha=0.3)
-    if args.title:
-        fig.suptitle(args.title)
+    if title:
+        fig.suptitle(title)
     fig.tight_layout()
-    fig.savefig(args.png, dpi=110)
+    return fig
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("trace")
+    parser.add_argument("png")
+    parser.add_argument("--title", default="")
+    args = parser.parse_args()
+    columns = read_trace(args.trace)
+    if not columns["time_s"]:
+        print(f"plot_session.py: {args.trace} has no samples", file=sys.stderr)
+        return 1
+    build_figure(columns, args.title).savefig(args.png, dpi=110)
     return 0
 
 

@@ -231,10 +231,17 @@ void read_hunt_crossley(TableReader& t, HuntCrossleyParams& hc) {
   t.finish();
 }
 
+/// A clamp's optional jaw gap [m]: when the key is absent, -1 (the description's "fully open at
+/// the start" / "unchanged on this leg"); when present, in [0, 10] m.
+double optional_jaw_gap_m(TableReader& t, const std::string& stem) {
+  if (t.find(stem, "m") == nullptr) return -1.0;
+  return t.in_range(stem, "m", 0.0, 10.0);
+}
+
 void read_trajectory(const std::string& file, TableReader& t, TrajectoryDescription& traj, bool clamp) {
   traj.start.position_world_m = t.vec3("start_position_world", "m");
   traj.start.orientation_world = quat_from_rpy_deg(t.vec3("start_orientation_rpy", "deg", Vec3{0.0, 0.0, 0.0}));
-  if (clamp) traj.start_jaw_gap_m = t.in_range("start_jaw_gap", "m", 0.0, 10.0, -1.0);
+  if (clamp) traj.start_jaw_gap_m = optional_jaw_gap_m(t, "start_jaw_gap");
   if (const toml::array* legs = t.array_of_tables("waypoint")) {
     for (std::size_t i = 0; i < legs->size(); ++i) {
       TableReader w(file, *legs->get(i)->as_table(), child_path(t, "waypoint[" + std::to_string(i) + "]"));
@@ -242,7 +249,7 @@ void read_trajectory(const std::string& file, TableReader& t, TrajectoryDescript
       wp.position_world_m = w.vec3("position_world", "m");
       wp.speed_m_per_s = w.positive("speed", "m_per_s");
       wp.hold_s = w.in_range("hold", "s", 0.0, 1e6, 0.0);
-      if (clamp) wp.jaw_gap_m = w.in_range("jaw_gap", "m", 0.0, 10.0, -1.0);
+      if (clamp) wp.jaw_gap_m = optional_jaw_gap_m(w, "jaw_gap");
       w.finish();
       traj.waypoints.push_back(wp);
     }

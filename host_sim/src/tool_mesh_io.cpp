@@ -3,8 +3,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <map>
+#include <sstream>
 #include <stdexcept>
 #include <utility>
 
@@ -22,10 +25,47 @@ constexpr double kConvexityToleranceRatio = 1e-5;
 
 Eigen::Vector3d v3(const Vec3& v) { return {v[0], v[1], v[2]}; }
 
+/// Checks every vertex line ("v x y z") of an OBJ file for coordinates that are not finite
+/// numbers: the OBJ reader turns a token it cannot parse ("nan", "1,5") into 0, which would
+/// surface later as a misleading shape error ("not convex").
+void check_obj_vertex_lines(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::size_t vertex = 0;
+  for (int number = 1; std::getline(in, line); ++number) {
+    std::istringstream tokens(line);
+    std::string keyword;
+    if (!(tokens >> keyword) || keyword != "v") continue;
+    ++vertex;
+    for (const char axis : {'x', 'y', 'z'}) {
+      std::string token;
+      tokens >> token;
+      char* end = nullptr;
+      const double value = token.empty() ? 0.0 : std::strtod(token.c_str(), &end);
+      if (token.empty() || end != token.c_str() + token.size() || !std::isfinite(value)) {
+        throw std::runtime_error("'" + path + "' line " + std::to_string(number) + ": vertex " + std::to_string(vertex) +
+                                 " coordinate " + axis + " is '" + token + "', not a finite number");
+      }
+    }
+  }
+}
+
 }  // namespace
 
 void check_tool_mesh(const ToolMesh& mesh) {
-  if (mesh.vertices_m.size() < 4 || mesh.triangles.size() < 4) throw std::runtime_error("fewer than 4 vertices or 4 triangles");
+  if (mesh.vertices_m.size() < 4 || mesh.triangles.size() < 4) {
+    throw std::runtime_error("a closed convex tool needs at least 4 vertices and 4 triangles, the mesh has " +
+                             std::to_string(mesh.vertices_m.size()) + " vertices and " + std::to_string(mesh.triangles.size()) +
+                             " triangles");
+  }
+  for (std::size_t i = 0; i < mesh.vertices_m.size(); ++i) {
+    for (int axis = 0; axis < 3; ++axis) {
+      if (!std::isfinite(mesh.vertices_m[i][static_cast<std::size_t>(axis)])) {
+        throw std::runtime_error("vertex " + std::to_string(i + 1) + " has a non-finite coordinate (" + "xyz"[axis] + " = " +
+                                 std::to_string(mesh.vertices_m[i][static_cast<std::size_t>(axis)]) + ")");
+      }
+    }
+  }
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = Eigen::Vector3d::Constant(-1e300), centre = Eigen::Vector3d::Zero();
   for (const Vec3& v : mesh.vertices_m) {
     lo = lo.cwiseMin(v3(v));
@@ -66,8 +106,11 @@ ToolMesh read_tool_mesh_obj(const std::string& path) {
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> materials;
   std::string warn, err;
+  std::error_code code;
+  if (std::filesystem::is_directory(path, code)) throw std::runtime_error("'" + path + "' is a directory, not an OBJ file");
   std::ifstream probe(path);
   if (!probe) throw std::runtime_error("cannot open '" + path + "'");
+  check_obj_vertex_lines(path);
   if (!tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, path.c_str(), nullptr, true)) {
     throw std::runtime_error("'" + path + "' is not a readable OBJ: " + err);
   }

@@ -51,6 +51,7 @@ HostEndOutcome run_host_end(const HostEndOptions& options) {
   link_config.role = wire::Role::kHost;
   link_config.publish_rate_hz = static_cast<float>(1.0 / host_dt_s);
   link_config.session_id = fresh_session_id();
+  link_config.identity = wire::session_identity(scene.name, scene.device_mapping);
   LinkBridge bridge(*carrier, clock, link_config, kRtSilentAfter_ns);
   DeviceStateExchange state_in;
   ProxyExchange proxy_out;
@@ -104,7 +105,9 @@ HostEndOutcome run_host_end(const HostEndOptions& options) {
       paused_since_ns = now;
       ++outcome.pauses;
       const TimeNs age = bridge.peer_data_age_ns();
-      if (age == transport::kNeverReceived) {
+      if (bridge.status().peer_closed) {
+        log_info("rt_core closed the link cleanly: scene paused");
+      } else if (age == transport::kNeverReceived) {
         log_warn("rt_core sends no device state yet: scene paused");
       } else {
         log_warn("rt_core silent for %.0f ms: scene paused", to_seconds(age) * 1e3);
@@ -124,14 +127,21 @@ HostEndOutcome run_host_end(const HostEndOptions& options) {
   if (options.status_line && tty) std::fprintf(stderr, "\n");
   if (paused_since_ns >= 0) paused_total_ns += clock.now() - paused_since_ns;
   const BridgeStatus link = bridge.status();
+  if (established_at_ns >= 0) bridge.close();  // rt_core reports "closed cleanly by the host", not a lost link
+  outcome.rt_closed = link.peer_closed;
+  outcome.rt_lost = established_at_ns >= 0 && paused_since_ns >= 0 && !link.peer_closed && link.peer_silent;
   outcome.seconds = to_seconds(clock.now() - start_ns);
   outcome.steps = last.steps;
   outcome.late_steps = schedule.late_steps();
   outcome.paused_s = to_seconds(paused_total_ns);
   outcome.interrupted = interrupted(options);
+  const std::string link_story = established_at_ns < 0 ? "never established"
+                                 : outcome.rt_closed   ? "established, closed cleanly by rt_core"
+                                 : outcome.rt_lost     ? "established, LOST (rt_core silent at the end)"
+                                                       : "established";
   std::printf("fissure host: '%s' %.2f s | link %s | steps %llu (late %llu) | paused %llu× %.2f s | crossed nodes max %d | "
               "host force max %.2f N | discards %llu frames / %llu msgs | rt restarts %llu%s\n",
-              scene.name.c_str(), outcome.seconds, established_at_ns >= 0 ? "established" : "never established",
+              scene.name.c_str(), outcome.seconds, link_story.c_str(),
               static_cast<unsigned long long>(outcome.steps), static_cast<unsigned long long>(outcome.late_steps),
               static_cast<unsigned long long>(outcome.pauses), outcome.paused_s, outcome.crossed_nodes_max,
               outcome.host_force_max_n, static_cast<unsigned long long>(link.frames_discarded),
@@ -139,6 +149,9 @@ HostEndOutcome run_host_end(const HostEndOptions& options) {
               outcome.interrupted ? " | stopped by Ctrl-C" : "");
   std::fflush(stdout);
   if (established_at_ns < 0) throw SessionError("rt_core at " + options.transport + " never answered: link not established");
+  if (outcome.rt_lost) {
+    throw SessionError("link lost: rt_core at " + options.transport + " went silent without closing the link (crashed, killed or cut off)");
+  }
   return outcome;
 }
 

@@ -73,6 +73,10 @@ void LinkBridge::pump_host(DeviceStateExchange& to_host, ProxyExchange& from_hos
   announce_while_silent();
 }
 
+void LinkBridge::close() noexcept {
+  for (int i = 0; i < kGoodbyeRepeats; ++i) endpoint_.close();
+}
+
 TimeNs LinkBridge::peer_data_age_ns() const noexcept {
   const transport::LinkReceiver& receiver = endpoint_.receiver();
   return role_ == wire::Role::kHost ? receiver.device_state_age_ns() : receiver.proxy_age_ns();
@@ -87,6 +91,7 @@ BridgeStatus LinkBridge::status() const noexcept {
   out.error = endpoint_.handshake().error_message();
   out.peer_data_age_ns = peer_data_age_ns();
   out.peer_silent = peer_silent();
+  out.peer_closed = endpoint_.handshake().peer_closed();
   out.messages_in = messages_in_;
   out.messages_out = messages_out_;
   const wire::WireStats& wire_stats = endpoint_.receiver().wire_stats();
@@ -109,11 +114,12 @@ std::string format_bridge_status(const BridgeStatus& status, wire::Role role) {
   // A handshake once done is not a live link: a silent peer (dead, or cut off) is "link lost".
   const char* link = status.failed                               ? "link REFUSED"
                      : !status.established                       ? "link waiting"
+                     : status.peer_closed                        ? "link closed by the peer"
                      : status.peer_silent                        ? "link LOST"
                                                                  : "link up";
   char line[256];
   std::snprintf(line, sizeof line, "%s | %s %s%s | in %llu out %llu | discards %llu frames / %llu msgs | restarts %llu",
-                link, age_name, age, status.established && status.peer_silent ? " (peer silent)" : "",
+                link, age_name, age, status.established && status.peer_silent && !status.peer_closed ? " (peer silent)" : "",
                 static_cast<unsigned long long>(status.messages_in), static_cast<unsigned long long>(status.messages_out),
                 static_cast<unsigned long long>(status.frames_discarded),
                 static_cast<unsigned long long>(status.messages_discarded),

@@ -40,7 +40,11 @@ bool interrupted(const RtEndOptions& options) {
 std::string describe_link(const RtEndOutcome& outcome) {
   if (!outcome.link_established) return "never established";
   char text[160];
-  if (outcome.host_lost_at_s >= 0.0) {
+  if (outcome.host_closed_at_s >= 0.0) {
+    std::snprintf(text, sizeof text, "established at %.2f s, closed cleanly by the host at %.2f s (%llu loss%s)",
+                  outcome.link_established_at_s, outcome.host_closed_at_s, static_cast<unsigned long long>(outcome.host_losses),
+                  outcome.host_losses == 1 ? "" : "es");
+  } else if (outcome.host_lost_at_s >= 0.0) {
     std::snprintf(text, sizeof text, "established at %.2f s, host silent from %.2f s to the end (%llu loss%s)",
                   outcome.link_established_at_s, outcome.host_lost_at_s, static_cast<unsigned long long>(outcome.host_losses),
                   outcome.host_losses == 1 ? "" : "es");
@@ -69,6 +73,11 @@ RtEndOutcome run_rt_end(const RtEndOptions& options) {
   link_config.role = wire::Role::kRt;
   link_config.publish_rate_hz = static_cast<float>(options.rate_hz);
   link_config.session_id = fresh_session_id();
+  if (!options.scene_name.empty()) {
+    link_config.identity = wire::session_identity(options.scene_name, options.device_mapping);
+  } else {
+    log_warn("%s: no --scene: the default device mapping, and the host's scene is not checked against it", options.program);
+  }
   LinkBridge bridge(*carrier, clock, link_config, kHostSilentAfter_ns);
 
   std::atomic<bool> stop_rt{false};
@@ -124,9 +133,18 @@ RtEndOutcome run_rt_end(const RtEndOptions& options) {
       log_info("link established with the host");
     }
     if (link.failed) stop_rt.store(true);  // a refused peer sends nothing usable: ramp out and stop
+    if (link.peer_closed && outcome.host_closed_at_s < 0.0) {
+      outcome.host_closed_at_s = to_seconds(clock.now() - start_ns);
+      log_info("the host closed the link cleanly: rt_core fades the force to zero");
+    } else if (!link.peer_closed) {
+      outcome.host_closed_at_s = -1.0;  // a host that came back is live again
+    }
     // Host death (or link loss): report when rt_core's fade has taken the force to zero.
     const bool host_live = link.established && !link.peer_silent;
-    if (host_was_live && !host_live) {
+    if (host_was_live && !host_live && link.peer_closed) {
+      silent_since_ns = clock.now();
+      fade_reported = false;
+    } else if (host_was_live && !host_live) {
       silent_since_ns = clock.now();
       outcome.host_lost_at_s = to_seconds(silent_since_ns - kHostSilentAfter_ns - start_ns);
       ++outcome.host_losses;
@@ -154,6 +172,7 @@ RtEndOutcome run_rt_end(const RtEndOptions& options) {
   rt_thread.join();
   stop_service.store(true);
   service_thread.join();
+  if (bridge.established()) bridge.close();  // the host reports "closed by rt_core", not a lost link
   if (options.status_line && tty) std::fprintf(stderr, "\n");
   const rt::RtSetupReport& setup = rt_thread.setup_report();
   if (rt_thread.refused()) throw SessionError(std::string("--rt-policy enforce: ") + setup.message);
@@ -183,6 +202,12 @@ RtEndOutcome run_rt_end(const RtEndOptions& options) {
   if (!outcome.link_established) {
     throw SessionError("no host answered on " + options.transport +
                        ": link never established (is `fissure host` running with its --transport pointing at this end?)");
+  }
+  if (outcome.host_lost_at_s >= 0.0 && outcome.host_closed_at_s < 0.0) {
+    char text[160];
+    std::snprintf(text, sizeof text, "link lost: the host went silent at %.2f s without closing the link (crashed, killed or cut off)",
+                  outcome.host_lost_at_s);
+    throw SessionError(text);
   }
   return outcome;
 }

@@ -17,6 +17,9 @@
 #include <spdlog/spdlog.h>
 
 #include "fissure/session/session_error.hpp"
+#include "fissure/falcon_hw/device_recording.hpp"
+#include "fissure/falcon_hw/recording_device.hpp"
+#include "fissure/falcon_hw/replay_device.hpp"
 #include "fissure/falcon_hw/sim_falcon.hpp"
 #include "fissure/rt_core/faults.hpp"
 #include "fissure/rt_core/rt_config.hpp"
@@ -80,6 +83,26 @@ std::string first_non_finite_key(const nlohmann::json& j, const std::string& pat
     }
   }
   return {};
+}
+
+/// --replay's recording, read and checked before anything else runs; null without --replay.
+std::unique_ptr<const falcon::DeviceRecording> load_replay(const SessionOptions& options, const host::SceneDescription& scene) {
+  if (options.replay_path.empty()) return nullptr;
+  if (options.device == SessionDevice::kUsb) {
+    throw SessionError("--replay answers from a recording instead of a device: it needs --device sim, not usb", true);
+  }
+  auto recording = std::make_unique<falcon::DeviceRecording>();
+  try {
+    *recording = falcon::read_recording(options.replay_path);
+    if (recording->exchanges.empty()) throw falcon::RecordingError(options.replay_path.string() + ": holds no exchanges: nothing to replay");
+  } catch (const falcon::RecordingError& e) {
+    throw SessionError(std::string("--replay: ") + e.what(), true);
+  }
+  if (recording->header.scene_name != scene.name) {
+    spdlog::warn("--replay: '{}' was recorded with scene '{}', this session runs '{}'", options.replay_path.string(),
+                 recording->header.scene_name, scene.name);
+  }
+  return recording;
 }
 
 /// Whole seconds the longest session may last: a day at the bench. Longer is a typo (1e9) and
@@ -259,6 +282,8 @@ struct SessionParts {
   StatusPrinter& status;
   viewer::SessionView* view;        ///< null without --view/--frames
   UsbFalcon* usb;                   ///< the opened USB Falcon (--device usb), else null
+  const falcon::DeviceRecording* replay;  ///< --replay's recording, else null
+  falcon::RecordingWriter* record;  ///< --record's writer, else null
   RtFiguresTracker rt_figures{};
   double duration_s = 0.0;          ///< 0: until interrupted
   [[nodiscard]] double host_dt_s() const { return scene.simulation.time_step_s; }
@@ -276,6 +301,69 @@ struct RunFigures {
   double wakeup_max_us = 0.0;
   double max_tick_us = 0.0;
   nlohmann::json extra;             ///< mode-specific keys added to the summary
+};
+
+/// The device a run mode talks to: SimFalcon, the USB Falcon or a replayed recording, behind a
+/// RecordingDevice with --record. Built on the run mode's clock, so recorded and replayed times
+/// count from the same moment (the device's construction, just before the rt stack's).
+class SessionDevices {
+ public:
+  SessionDevices(const SessionParts& parts, const falcon::SimFalconConfig& sim_config, const Clock& clock) {
+    if (parts.replay != nullptr) {
+      replay_ = std::make_unique<falcon::ReplayDevice>(*parts.replay, clock);
+      device_ = replay_.get();
+    } else if (parts.usb != nullptr) {
+      device_ = &parts.usb->device();
+    } else {
+      sim_ = std::make_unique<falcon::SimFalcon>(sim_config, clock);
+      device_ = sim_.get();
+    }
+    if (parts.record != nullptr) {
+      recording_ = std::make_unique<falcon::RecordingDevice>(*device_, clock);
+      device_ = recording_.get();
+    }
+  }
+  [[nodiscard]] falcon::HapticDevice& device() const noexcept { return *device_; }
+  /// Non-RT side: moves the recorded exchanges to the file.
+  void drain_recording(const SessionParts& parts) {
+    if (recording_) recording_->drain(*parts.record);
+  }
+  /// After the run: the last exchanges, then the end record (`stop_ns` on the run's clock).
+  void finish_recording(const SessionParts& parts, TimeNs stop_ns, nlohmann::json& extra) {
+    if (!recording_) return;
+    recording_->drain(*parts.record);
+    parts.record->finish(recording_->records_lost(), recording_->recording_time(stop_ns));
+    extra["recording"] = {{"file", parts.options.record_path.string()},
+                          {"exchanges", parts.record->records()},
+                          {"lost", recording_->records_lost()}};
+    if (recording_->records_lost() != 0) {
+      spdlog::error("--record: {} exchanges were lost (the recording fell behind); the file cannot be replayed",
+                    recording_->records_lost());
+    }
+  }
+  void report(const SessionParts& parts, nlohmann::json& extra) const {
+    if (sim_) {
+      extra["sim_falcon"] = {{"exchanges", sim_->counters().exchanges}, {"kinematics_failures", sim_->counters().kinematics_failures}};
+    }
+    if (replay_) {
+      const falcon::ReplayCounters& c = replay_->counters();
+      extra["replay"] = {{"file", parts.options.replay_path.string()},
+                         {"recorded_device", parts.replay->header.device_name},
+                         {"recorded_scene", parts.replay->header.scene_name},
+                         {"recorded_rt_rate_hz", parts.replay->header.rt_rate_hz},
+                         {"records", parts.replay->exchanges.size()},
+                         {"exchanges", c.exchanges},
+                         {"records_used", c.records_used},
+                         {"commands_differing", c.commands_differing},
+                         {"exchanges_after_end", c.after_end}};
+    }
+  }
+
+ private:
+  std::unique_ptr<falcon::SimFalcon> sim_;
+  std::unique_ptr<falcon::ReplayDevice> replay_;
+  std::unique_ptr<falcon::RecordingDevice> recording_;
+  falcon::HapticDevice* device_ = nullptr;
 };
 
 // The view's picture model is built from the settled body (its rest shape is what the
@@ -315,9 +403,9 @@ std::unique_ptr<viewer::SessionView> start_view(const SessionOptions& options, S
 /// Lockstep: one thread on a LockstepClock — N rt ticks, one host step, repeat.
 void run_lockstep(SessionParts& parts, const falcon::SimFalconConfig& sim_config, RunFigures& out) {
   LockstepClock clock(0);
-  falcon::SimFalcon device(sim_config, clock);
-  out.device_name = device.name();
-  RtStack rt(parts.model, device, clock);
+  SessionDevices devices(parts, sim_config, clock);
+  out.device_name = devices.device().name();
+  RtStack rt(parts.model, devices.device(), clock);
   rt::RtLoop& loop = rt.loop();
   RtChannels& channels = rt.channels();
   const double host_dt_s = parts.host_dt_s();
@@ -325,9 +413,14 @@ void run_lockstep(SessionParts& parts, const falcon::SimFalconConfig& sim_config
   const auto ticks_per_host = static_cast<std::uint64_t>(std::llround(ratio));  // whole: check_lockstep_rates
   const auto end_ns = static_cast<TimeNs>(std::llround(parts.duration_s * 1e9));
   rt::TelemetrySample sample;
+  std::optional<TimeNs> stop_ns;
   while (!loop.stopped()) {
-    if (clock.now() >= end_ns || interrupted(parts.options) || !parts.recorder.figures().first_non_finite.empty()) loop.request_stop();
+    if (clock.now() >= end_ns || interrupted(parts.options) || !parts.recorder.figures().first_non_finite.empty()) {
+      loop.request_stop();
+      if (!stop_ns) stop_ns = clock.now();
+    }
     for (std::uint64_t k = 0; k < ticks_per_host && !loop.stopped(); ++k) loop.step();
+    devices.drain_recording(parts);
     const HostStatus& host_status = parts.host.step(channels.state, channels.proxy);
     parts.recorder.add_host_step(host_status);
     while (channels.telemetry.try_pop(sample)) parts.recorder.add_tick(sample, host_status);
@@ -340,8 +433,8 @@ void run_lockstep(SessionParts& parts, const falcon::SimFalconConfig& sim_config
   }
   loop.send_zero_command();
   out.proxies_rejected = loop.data().proxy.rejected_count;
-  out.extra["sim_falcon"] = {{"exchanges", device.counters().exchanges},
-                             {"kinematics_failures", device.counters().kinematics_failures}};
+  devices.report(parts, out.extra);
+  devices.finish_recording(parts, stop_ns.value_or(clock.now()), out.extra);
 }
 
 /// Real time: the rt thread (SCHED_FIFO best effort) and the host thread (one step per host
@@ -350,9 +443,8 @@ void run_realtime(SessionParts& parts, const falcon::SimFalconConfig& sim_config
   const SessionOptions& options = parts.options;
   const bool until_interrupted = parts.duration_s <= 0.0;
   MonotonicClock clock;
-  std::unique_ptr<falcon::HapticDevice> device;
-  if (parts.usb == nullptr) device = std::make_unique<falcon::SimFalcon>(sim_config, clock);
-  falcon::HapticDevice& haptic = parts.usb != nullptr ? parts.usb->device() : *device;
+  SessionDevices devices(parts, sim_config, clock);
+  falcon::HapticDevice& haptic = devices.device();
   out.device_name = haptic.name();
   RtStack rt(parts.model, haptic, clock);
   rt::RtLoop& loop = rt.loop();
@@ -394,10 +486,15 @@ void run_realtime(SessionParts& parts, const falcon::SimFalconConfig& sim_config
   auto drain = [&] {
     while (host_statuses->try_pop(host_status)) parts.recorder.add_host_step(host_status);
     while (channels.telemetry.try_pop(sample)) parts.recorder.add_tick(sample, host_status);
+    devices.drain_recording(parts);
   };
+  std::optional<TimeNs> stop_ns;
   while (!rt_thread.done()) {
     std::this_thread::sleep_for(std::chrono::milliseconds(kDrainPeriod_ms));
-    if (interrupted(options) || !parts.recorder.figures().first_non_finite.empty()) stop_rt.store(true);
+    if (interrupted(options) || !parts.recorder.figures().first_non_finite.empty()) {
+      stop_rt.store(true);
+      if (!stop_ns) stop_ns = clock.now();
+    }
     drain();
     if (parts.view != nullptr) parts.view->rt_figures().publish(parts.rt_figures.update(parts.recorder));
     out.session_time_s = to_seconds(clock.now() - start_ns);
@@ -422,6 +519,11 @@ void run_realtime(SessionParts& parts, const falcon::SimFalconConfig& sim_config
                            {"warnings", std::string(setup_report.message)}};
   if (setup_report.message[0] != '\0') spdlog::warn("rt thread: {}", setup_report.message);
   if (!host_error.empty()) out.extra["host_error"] = host_error;
+  devices.report(parts, out.extra);
+  // The session's end: Ctrl-C's moment, else the duration counted from the first tick.
+  const TimeNs first_tick_ns = parts.recorder.figures().telemetry_samples != 0 ? parts.recorder.figures().first_tick_time_ns : start_ns;
+  const TimeNs planned_stop_ns = until_interrupted ? clock.now() : first_tick_ns + (end_ns - start_ns);
+  devices.finish_recording(parts, stop_ns ? std::min(*stop_ns, planned_stop_ns) : planned_stop_ns, out.extra);
 }
 
 nlohmann::json view_json(const SessionOptions& options, const viewer::SessionViewStats& stats) {
@@ -468,6 +570,11 @@ nlohmann::json summary_json(const SessionParts& parts, const RunFigures& run, do
   summary["soft_everted"] = f.soft_volume_ratio_min < 0.0;
   summary["faults"] = f.fault_ticks;
   summary["fault_kinds"] = fault_names(f.fault_bits_seen);
+  // The flag bits of fault_bits (16..20) are not faults: ticks with each, by name, so a trace row
+  // with fault_bits 524288 and "faults": 0 explain each other (docs/session.md).
+  nlohmann::json flags = nlohmann::json::object();
+  for (std::size_t flag = 0; flag < f.flag_ticks.size(); ++flag) flags[rt::fault_name(rt::kFlagForceClamped << flag)] = f.flag_ticks[flag];
+  summary["flag_ticks"] = flags;
   summary["proxies_rejected"] = run.proxies_rejected;
   summary["overruns"] = f.overruns;
   summary["force_max_n"] = f.force_max_n;
@@ -553,13 +660,28 @@ SessionOutcome run_session(const SessionOptions& options) {
   const rt::RtModel model = build_rt_model(config);
 
   const double host_dt_s = scene.simulation.time_step_s;
+  const std::unique_ptr<const falcon::DeviceRecording> replay = load_replay(options, scene);
   double duration_s = options.duration_s;
+  if (replay) {
+    const double recorded_s = to_seconds(replay->session_end_ns);
+    if (duration_s > recorded_s) {
+      throw SessionError("--duration " + plain_number(duration_s) + " s is longer than the recorded session in '" +
+                             options.replay_path.string() + "' (" + plain_number(recorded_s) + " s)",
+                         true);
+    }
+    if (duration_s <= 0.0) duration_s = recorded_s;
+  }
   if (duration_s <= 0.0 && options.device == SessionDevice::kSim) duration_s = hand_script_duration_s(scene.hand);
   if (duration_s <= 0.0 && options.lockstep) {
     throw SessionError("--lockstep needs a duration: the scene's hand script is empty");
   }
   check_duration(options, scene, duration_s);
   const bool until_interrupted = duration_s <= 0.0;
+
+  if (!options.replay_path.empty() && !options.record_path.empty() &&
+      std::filesystem::weakly_canonical(options.replay_path) == std::filesystem::weakly_canonical(options.record_path)) {
+    throw SessionError("--record and --replay name the same file '" + options.record_path.string() + "'", true);
+  }
 
   MonotonicClock usb_clock;
   std::unique_ptr<UsbFalcon> usb;
@@ -578,8 +700,20 @@ SessionOutcome run_session(const SessionOptions& options) {
   const double expected_s = until_interrupted ? 60.0 : duration_s + 1.0;
   std::unique_ptr<viewer::SessionView> view = start_view(options, host, expected_s, host_dt_s, staged_frames);
   SessionRecorder recorder(staging.file(options.out_dir / "trace.csv"));
+  std::unique_ptr<falcon::RecordingWriter> record;
+  if (!options.record_path.empty()) {
+    falcon::RecordingHeader header;
+    header.rt_rate_hz = options.rt_rate_hz;
+    header.device_name = replay ? "replay" : options.device == SessionDevice::kUsb ? "usb-falcon" : "sim-falcon";
+    header.scene_name = scene.name;
+    try {
+      record = std::make_unique<falcon::RecordingWriter>(staging.file(options.record_path), header);
+    } catch (const falcon::RecordingError& e) {
+      throw SessionError(std::string("--record: ") + e.what());
+    }
+  }
   StatusPrinter status(options.status_line);
-  SessionParts parts{options, scene, model, host, recorder, status, view.get(), usb.get()};
+  SessionParts parts{options, scene, model, host, recorder, status, view.get(), usb.get(), replay.get(), record.get()};
   parts.duration_s = duration_s;
   const WallClock::time_point wall_start = WallClock::now();
   falcon::SimFalconConfig sim_config;

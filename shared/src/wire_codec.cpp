@@ -227,10 +227,14 @@ EncodeStatus encode(const Hello& hello, std::uint8_t transfer_id, FrameBatch& ou
   writer.u8(hello.flags);
   writer.u32(hello.session_id);
   writer.f32(hello.publish_rate_hz);
+  if (hello.protocol_version >= kHelloFingerprintVersion) {
+    writer.u64(hello.session_fingerprint);
+    for (const char c : hello.scene_name) writer.u8(static_cast<std::uint8_t>(c));
+  }
   // The Hello carries the full 16-bit version in its body; the header byte is its low byte
   // (informative only: a Hello is decoded whatever the header's version says).
   segment(static_cast<std::uint8_t>(hello.protocol_version), MessageType::kHello, transfer_id, message.data(),
-          message.size(), out);
+          hello_message_bytes(hello.protocol_version), out);
   return EncodeStatus::kOk;
 }
 
@@ -256,7 +260,9 @@ std::size_t max_segments_for(MessageType type) noexcept {
 
 std::size_t message_bytes_for(MessageType type, const std::uint8_t* message, std::size_t available) noexcept {
   switch (type) {
-    case MessageType::kHello: return kHelloMessageBytes;
+    case MessageType::kHello:
+      if (available < 2) return 0;
+      return hello_message_bytes(static_cast<std::uint16_t>(message[0] | (message[1] << 8)));
     case MessageType::kDeviceState: return kDeviceStateMessageBytes;
     case MessageType::kContactProxy: {
       constexpr std::size_t kPatchCountOffset = 16;
@@ -327,6 +333,12 @@ void decode_hello(const std::uint8_t* message, Hello& out) noexcept {
   out.flags = reader.u8();
   out.session_id = reader.u32();
   out.publish_rate_hz = reader.f32();
+  out.session_fingerprint = 0;
+  out.scene_name.fill('\0');
+  if (out.protocol_version < kHelloFingerprintVersion) return;
+  out.session_fingerprint = reader.u64();
+  for (char& c : out.scene_name) c = static_cast<char>(reader.u8());
+  out.scene_name.back() = '\0';  // a peer's name is printed: always terminated
 }
 
 }  // namespace fissure::wire

@@ -144,9 +144,14 @@ bool LinkReceiver::try_take_device_state(DeviceState& out) noexcept {
 LinkEndpoint::LinkEndpoint(FrameCarrier& carrier, const Clock& clock, const LinkConfig& config) noexcept
     : clock_(clock),
       config_(config),
-      handshake_(config.role, config.publish_rate_hz, config.session_id),
+      handshake_(config.role, config.publish_rate_hz, config.session_id, config.identity),
       sender_(carrier),
       receiver_(carrier, clock, &handshake_, config.receiver) {}
+
+void LinkEndpoint::close() noexcept {
+  sender_.publish(handshake_.hello(true));
+  sender_.service();
+}
 
 LinkPollResult LinkEndpoint::tick() noexcept {
   const LinkPollResult result = receiver_.poll();

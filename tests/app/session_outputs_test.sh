@@ -44,5 +44,16 @@ expect_refusal "at most 86400 s" sim spatula-sphere --seconds 1e9
 expect_refusal "known scenes: clamp-sphere, clamp-vessel, convex-spatula-sphere, spatula-sphere" run no-such-scene --lockstep
 expect_refusal "is a directory, not a scene file" run "$work" --lockstep
 
+# Record and replay through the command line: the replayed lockstep trace is the recorded one.
+"$fissure" run spatula-sphere --lockstep --duration 0.4 --settle 0.2 --no-plot --quiet --out "$work/rec" \
+  --record "$work/session.frec" >/dev/null 2>&1 || bad "the recording run failed"
+replay_out=$("$fissure" run spatula-sphere --lockstep --settle 0.2 --no-plot --quiet --out "$work/rep" \
+  --replay "$work/session.frec" 2>&1) || bad "the replay run failed: $replay_out"
+grep -q "0 commands differing from the recorded ones" <<<"$replay_out" || bad "replay summary line: $replay_out"
+cmp -s "$work/rec/trace.csv" "$work/rep/trace.csv" || bad "the replayed trace differs from the recorded one"
+head -c 40 "$work/session.frec" >"$work/cut.frec"
+expect_refusal "cut.frec: at byte offset" run spatula-sphere --lockstep --replay "$work/cut.frec" --out "$work/rep"
+expect_refusal "it needs --device sim" run spatula-sphere --device usb --replay "$work/session.frec" --out "$work/rep"
+
 [[ $fail -eq 0 ]] && echo "session outputs hold"
 exit $fail

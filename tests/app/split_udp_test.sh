@@ -2,8 +2,11 @@
 # Split deployment over real UDP on loopback, two processes (issue 6):
 #   fissure rt   --transport udp:127.0.0.1:PORT --scene spatula-sphere   (background)
 #   fissure host spatula-sphere --transport udp:127.0.0.1:PORT --seconds 2
-# Checks: the host exits 0 having established the link and stepped; the rt end notices the
-# host's exit (host silent → fade) and, on SIGINT (Ctrl-C), ramps out and exits 0.
+# Checks: the host exits 0 having established the link and stepped; the rt end reports the
+# host's clean exit as "closed cleanly by the host" (not "host silent") and, on SIGINT (Ctrl-C),
+# ramps out and exits 0. Then (issue 25) a host killed with SIGKILL: the rt end reports the host
+# silent and exits 1 "link lost"; and an rt on clamp-vessel with a host on spatula-sphere: both
+# refuse the link naming both scenes, exit 1.
 # Bounded: every wait has a timeout; loopback only.
 set -u
 fissure="$1"
@@ -35,7 +38,43 @@ show() { echo "--- host stdout"; cat "$log_dir/host.out"; echo "--- host stderr"
 grep -q "link established" "$log_dir/host.out" || { echo "FAIL: host did not report the link established"; fail=1; }
 grep -Eq "steps [1-9][0-9]*" "$log_dir/host.out" || { echo "FAIL: host never stepped"; fail=1; }
 grep -q "link established" "$log_dir/rt.out" || { echo "FAIL: rt did not report the link established"; fail=1; }
-cat "$log_dir/rt.out" "$log_dir/rt.err" | grep -q "host silent" || { echo "FAIL: rt did not notice the host's exit"; fail=1; }
+grep -q "closed cleanly by the host" "$log_dir/rt.out" || { echo "FAIL: rt did not report the host's clean exit"; fail=1; }
+grep -q "host silent" "$log_dir/rt.err" && { echo "FAIL: a clean host exit was reported as 'host silent'"; fail=1; }
 grep -q "stopped by Ctrl-C" "$log_dir/rt.out" || { echo "FAIL: rt did not report the Ctrl-C stop"; fail=1; }
 show
+
+# A host that dies: silent without a goodbye.
+port2=$((port + 1)); spec2="udp:127.0.0.1:${port2}"
+"$fissure" rt --transport "$spec2" --scene spatula-sphere --seconds 60 --quiet >"$log_dir/rt2.out" 2>"$log_dir/rt2.err" &
+rt_pid=$!
+"$fissure" host spatula-sphere --transport "$spec2" --seconds 60 --settle 0.2 --connect-timeout 20 --quiet \
+  >"$log_dir/host2.out" 2>"$log_dir/host2.err" &
+host_pid=$!
+for _ in $(seq 1 300); do grep -q "link established" "$log_dir/rt2.err" && break; sleep 0.1; done
+sleep 0.5
+kill -KILL "$host_pid"; wait "$host_pid" 2>/dev/null
+sleep 1
+kill -INT "$rt_pid"
+for _ in $(seq 1 100); do kill -0 "$rt_pid" 2>/dev/null || break; sleep 0.1; done
+wait "$rt_pid"; rt2_rc=$?; rt_pid=
+[ "$rt2_rc" -eq 1 ] || { echo "FAIL: after the host was killed fissure rt exited $rt2_rc, want 1"; fail=1; }
+grep -q "host silent" "$log_dir/rt2.err" || { echo "FAIL: rt did not report the killed host silent"; fail=1; }
+grep -q "link lost: the host went silent" "$log_dir/rt2.err" || { echo "FAIL: rt did not say the link was lost"; fail=1; }
+echo "--- killed host: rt stdout"; cat "$log_dir/rt2.out"; echo "--- rt stderr"; tail -5 "$log_dir/rt2.err"
+
+# Mismatched scenes: refused at both ends, both scenes named.
+port3=$((port + 2)); spec3="udp:127.0.0.1:${port3}"
+timeout 30 "$fissure" rt --transport "$spec3" --scene clamp-vessel --seconds 20 --quiet >"$log_dir/rt3.out" 2>"$log_dir/rt3.err" &
+rt_pid=$!
+timeout 30 "$fissure" host spatula-sphere --transport "$spec3" --seconds 20 --settle 0.2 --connect-timeout 20 --quiet \
+  >"$log_dir/host3.out" 2>"$log_dir/host3.err"
+host3_rc=$?
+wait "$rt_pid"; rt3_rc=$?; rt_pid=
+[ "$host3_rc" -eq 1 ] || { echo "FAIL: mismatched host exited $host3_rc, want 1"; fail=1; }
+[ "$rt3_rc" -eq 1 ] || { echo "FAIL: mismatched rt exited $rt3_rc, want 1"; fail=1; }
+grep -q "session mismatch: this host runs scene 'spatula-sphere'.*the rt peer runs scene 'clamp-vessel'" "$log_dir/host3.err" ||
+  { echo "FAIL: the host did not name both scenes"; fail=1; }
+grep -q "session mismatch: this rt runs scene 'clamp-vessel'.*the host peer runs scene 'spatula-sphere'" "$log_dir/rt3.err" ||
+  { echo "FAIL: the rt end did not name both scenes"; fail=1; }
+echo "--- mismatch: host stderr"; tail -2 "$log_dir/host3.err"; echo "--- rt stderr"; tail -2 "$log_dir/rt3.err"
 exit $fail

@@ -224,6 +224,42 @@ TEST(SceneLoader, UnreadableMeshNamesMeshPath) {
   expect_error(load_error(open), line_of(open, "mesh_path"), "tool.mesh_path", "unreadable mesh");
 }
 
+TEST(SceneLoader, MeshPathsThatAreNoMeshAreNamedInTheMeshsTerms) {
+  const std::string good = read(kScenes / "convex-spatula-sphere.toml");
+  const auto dir = std::filesystem::temp_directory_path() / "fissure_scene_loader_mesh_terms";
+  std::filesystem::create_directories(dir / "a-directory.obj");
+  // A directory: said so, not "fewer than 4 vertices".
+  const std::string directory = replace(good, "meshes/convex-spatula.obj", (dir / "a-directory.obj").string());
+  expect_error(load_error(directory), line_of(directory, "mesh_path"), "tool.mesh_path", "is a directory, not an OBJ file");
+  // A NaN coordinate: the OBJ line, the vertex and the value, not "not convex".
+  std::string obj = read(kScenes / "meshes" / "convex-spatula.obj");
+  const std::size_t first_v = obj.find("\nv ") + 1;
+  const std::size_t end_of_line = obj.find('\n', first_v);
+  obj.replace(first_v, end_of_line - first_v, "v 0.029 nan 0.0045");
+  std::ofstream(dir / "nan.obj") << obj;
+  const std::string nan = replace(good, "meshes/convex-spatula.obj", (dir / "nan.obj").string());
+  const SceneError e = load_error(nan);
+  expect_error(e, line_of(nan, "mesh_path"), "tool.mesh_path", "nan.obj' line 2: vertex 1 coordinate y is 'nan', not a finite number");
+  EXPECT_EQ(std::string(e.what()).find("convex"), std::string::npos) << e.what();
+  // Too few elements: both counts.
+  std::ofstream(dir / "two.obj") << "v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n";
+  const std::string two = replace(good, "meshes/convex-spatula.obj", (dir / "two.obj").string());
+  expect_error(load_error(two), line_of(two, "mesh_path"), "tool.mesh_path", "the mesh has 3 vertices and 1 triangles");
+  std::filesystem::remove_all(dir);
+}
+
+TEST(SceneLoader, AClampWithoutStartOrLegJawGapsKeepsThemOpen) {
+  // Both are optional: absent, the jaws start fully open and a leg keeps the gap it has.
+  const std::string good = read(kScenes / "clamp-vessel.toml");
+  std::string without = replace(good, "start_jaw_gap_m = 0.05\n", "");
+  without = replace(without, "jaw_gap_m = 0.05\n", "");
+  const SceneDescription scene = load_scene_text(without, "clamp.toml", kScenes);
+  EXPECT_EQ(scene.trajectory.start_jaw_gap_m, -1.0);
+  EXPECT_EQ(scene.trajectory.waypoints.back().jaw_gap_m, -1.0);
+  const std::string negative = replace(good, "start_jaw_gap_m = 0.05", "start_jaw_gap_m = -0.01");
+  expect_error(load_error(negative), line_of(negative, "start_jaw_gap_m"), "trajectory.start_jaw_gap_m", "must be in [0, 10] (got -0.01)");
+}
+
 TEST(SceneLoader, BadTomlSyntaxNamesLine) {
   const std::string good = read(kScenes / "spatula-sphere.toml");
   const std::string bad = replace(good, "radius_m = 0.05", "radius_m = = 0.05");

@@ -3,7 +3,7 @@ if(TARGET fissure)
   add_test(NAME app.split_udp_two_processes
     COMMAND bash ${CMAKE_SOURCE_DIR}/tests/app/split_udp_test.sh $<TARGET_FILE:fissure>
     WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
-  set_tests_properties(app.split_udp_two_processes PROPERTIES LABELS "unit" TIMEOUT 90)
+  set_tests_properties(app.split_udp_two_processes PROPERTIES LABELS "unit" TIMEOUT 180)
 endif()
 # Transport errors (one line, exit codes) and a 1 s `fissure hil latency` smoke run per transport.
 if(TARGET fissure)

@@ -43,7 +43,7 @@ grep -q "link established" "$log_dir/rt.out" || { echo "FAIL: fissure-rt did not
 grep -Eq "proxies used [1-9][0-9]*" "$log_dir/rt.out" || { echo "FAIL: fissure-rt applied no proxy"; fail=1; }
 grep -q "device fault ticks 0 " "$log_dir/rt.out" || { echo "FAIL: fissure-rt had ticks with device faults"; fail=1; }
 grep -q "proxies rejected 0 " "$log_dir/rt.out" || { echo "FAIL: fissure-rt rejected proxies"; fail=1; }
-grep -q "host silent" "$log_dir/rt.err" || { echo "FAIL: fissure-rt did not notice the host's exit"; fail=1; }
+grep -q "closed cleanly by the host" "$log_dir/rt.out" || { echo "FAIL: fissure-rt did not report the host's clean exit"; fail=1; }
 echo "--- host stdout"; cat "$log_dir/host.out"; echo "--- host stderr"; tail -5 "$log_dir/host.err"
 echo "--- fissure-rt stdout"; cat "$log_dir/rt.out"; echo "--- fissure-rt stderr"; tail -8 "$log_dir/rt.err"
 exit $fail

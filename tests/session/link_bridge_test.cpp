@@ -400,6 +400,63 @@ TEST(LinkBridge, AVersionMismatchedPeerIsRefusedWithBothVersionsNamed) {
   std::printf("%s\n", error.c_str());
 }
 
+/// rt and host bridges linked up over a loopback, both exchanging data, then the host either
+/// closes cleanly or stops dead; the rt bridge after 0.2 s of silence.
+BridgeStatus rt_view_after_host_stops(bool host_closes) {
+  LockstepClock clock(0);
+  transport::LoopbackLink link(clock);
+  transport::LinkConfig rt_config_link;
+  rt_config_link.role = wire::Role::kRt;
+  rt_config_link.session_id = 1;
+  rt_config_link.identity = wire::session_identity("spatula-sphere", DeviceMapping{});
+  transport::LinkConfig host_config_link = rt_config_link;
+  host_config_link.role = wire::Role::kHost;
+  host_config_link.session_id = 2;
+  LinkBridge rt_bridge(link.a(), clock, rt_config_link, kHostSilentAfter_ns);
+  DeviceStateExchange rt_state;
+  ProxyExchange rt_proxy;
+  {
+    LinkBridge host_bridge(link.b(), clock, host_config_link, kRtSilentAfter_ns);
+    DeviceStateExchange host_state;
+    ProxyExchange host_proxy;
+    for (std::uint64_t sequence = 1; sequence <= 50; ++sequence) {
+      DeviceState sample;
+      sample.sequence = sequence;
+      rt_state.publish(sample);
+      ContactProxy p;
+      p.sequence = sequence;
+      p.flags = kProxyValid;
+      host_proxy.publish(p);
+      rt_bridge.pump_rt(rt_state, rt_proxy);
+      host_bridge.pump_host(host_state, host_proxy);
+      clock.advance(kTickNs);
+    }
+    EXPECT_TRUE(rt_bridge.established());
+    EXPECT_FALSE(rt_bridge.status().peer_silent);
+    if (host_closes) host_bridge.close();
+  }
+  for (int i = 0; i < 200; ++i) {
+    rt_bridge.pump_rt(rt_state, rt_proxy);
+    clock.advance(kTickNs);
+  }
+  return rt_bridge.status();
+}
+
+TEST(LinkBridge, AHostThatClosesCleanlyIsNotReportedAsLost) {
+  const BridgeStatus closed = rt_view_after_host_stops(true);
+  EXPECT_TRUE(closed.peer_closed);
+  EXPECT_TRUE(closed.peer_silent) << "no proxies after the goodbye: rt_core fades as always";
+  EXPECT_NE(format_bridge_status(closed, wire::Role::kRt).find("link closed by the peer"), std::string::npos)
+      << format_bridge_status(closed, wire::Role::kRt);
+  EXPECT_EQ(format_bridge_status(closed, wire::Role::kRt).find("LOST"), std::string::npos);
+
+  const BridgeStatus crashed = rt_view_after_host_stops(false);
+  EXPECT_FALSE(crashed.peer_closed);
+  EXPECT_TRUE(crashed.peer_silent);
+  EXPECT_NE(format_bridge_status(crashed, wire::Role::kRt).find("link LOST"), std::string::npos)
+      << format_bridge_status(crashed, wire::Role::kRt);
+}
+
 TEST(LinkBridge, ARestartedHostKeepsTheProxySequenceIncreasingForRtCore) {
   LockstepClock clock(0);
   transport::LoopbackLink link(clock);

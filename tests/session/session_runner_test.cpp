@@ -143,5 +143,127 @@ TEST_F(SessionRunnerTest, AnInterruptedSessionStillWritesCompleteOutputs) {
   }
 }
 
+/// The largest value of a trace column (by its header name).
+double column_max(const std::string& trace, const std::string& column) {
+  std::istringstream lines(trace);
+  std::string header, row;
+  std::getline(lines, header);
+  int index = -1, at = 0;
+  std::istringstream names(header);
+  for (std::string name; std::getline(names, name, ','); ++at) {
+    if (name == column) index = at;
+  }
+  EXPECT_GE(index, 0) << column;
+  double max = 0.0;
+  while (std::getline(lines, row)) {
+    std::istringstream cells(row);
+    std::string cell;
+    for (int i = 0; i <= index; ++i) std::getline(cells, cell, ',');
+    max = std::max(max, std::stod(cell));
+  }
+  return max;
+}
+
+TEST_F(SessionRunnerTest, ARecordedLockstepSessionReplaysBitForBit) {
+  // Long enough for the hand to press the spatula into the ball: the replay must reproduce a
+  // contact, not just a free grip.
+  options_.duration_s = 1.2;
+  options_.settle_s = 0.2;
+  options_.record_path = out_ / "session.frec";
+  options_.out_dir = out_ / "recorded";
+  const SessionOutcome recorded = run_session(options_);
+  ASSERT_TRUE(fs::exists(out_ / "session.frec"));
+  EXPECT_EQ(recorded.summary["recording"]["lost"].get<int>(), 0);
+  const std::string recorded_trace = read_file(out_ / "recorded" / "trace.csv");
+  EXPECT_GT(column_max(recorded_trace, "contact_force_n"), 0.5) << "no contact to reproduce";
+
+  SessionOptions replay = options_;
+  replay.record_path.clear();
+  replay.replay_path = out_ / "session.frec";
+  replay.duration_s = 0.0;  // the recorded session's length
+  replay.out_dir = out_ / "replayed";
+  const SessionOutcome replayed = run_session(replay);
+  EXPECT_EQ(replayed.summary["device"], "replay");
+  EXPECT_EQ(replayed.summary["replay"]["recorded_device"], "sim-falcon");
+  EXPECT_EQ(replayed.summary["replay"]["commands_differing"].get<int>(), 0);
+  EXPECT_EQ(replayed.summary["replay"]["exchanges_after_end"].get<int>(), 0);
+  EXPECT_EQ(replayed.summary["ticks"], recorded.summary["ticks"]);
+  EXPECT_TRUE(read_file(out_ / "replayed" / "trace.csv") == recorded_trace) << "the replayed trace differs from the recorded one";
+  // The summary explains the trace's flag bits (fault_bits 16..20) by name, apart from faults.
+  for (const char* flag : {"force clamped", "force rate limited", "motor saturated", "passivity controller active", "soft wall"}) {
+    EXPECT_TRUE(recorded.summary["flag_ticks"].contains(flag)) << flag;
+  }
+
+  // And the replay is itself deterministic: a second replay, re-recorded, gives the same again.
+  replay.out_dir = out_ / "replayed-again";
+  replay.record_path = out_ / "again.frec";
+  (void)run_session(replay);
+  EXPECT_TRUE(read_file(out_ / "replayed-again" / "trace.csv") == recorded_trace);
+}
+
+TEST_F(SessionRunnerTest, AReplayRunsAtAnotherRateHostRateAndMethod) {
+  options_.duration_s = 0.3;
+  options_.record_path = out_ / "session.frec";
+  options_.out_dir = out_ / "recorded";
+  (void)run_session(options_);
+  SessionOptions replay = options_;
+  replay.record_path.clear();
+  replay.replay_path = out_ / "session.frec";
+  replay.duration_s = 0.0;
+  replay.rt_rate_hz = 2000.0;
+  replay.host_rate_hz = 500.0;
+  replay.scene.simulation.collision_method = host::SceneCollisionMethod::kRay;
+  replay.out_dir = out_ / "replayed";
+  const SessionOutcome outcome = run_session(replay);
+  const nlohmann::json& r = outcome.summary["replay"];
+  EXPECT_EQ(outcome.summary["rt_rate_hz"].get<double>(), 2000.0);
+  EXPECT_EQ(outcome.summary["host_rate_hz"].get<double>(), 500.0);
+  // Two ticks per recorded exchange: every record answered twice, none past the end.
+  EXPECT_EQ(r["records_used"], r["records"]);
+  EXPECT_NEAR(r["exchanges"].get<double>(), 2.0 * r["records"].get<double>(), 2.0);
+  EXPECT_EQ(r["exchanges_after_end"].get<int>(), 0);
+  EXPECT_EQ(outcome.summary["faults"].get<int>(), 0) << outcome.summary.dump(1);
+}
+
+TEST_F(SessionRunnerTest, AReplayThatCannotWorkIsRefusedBeforeTouchingEarlierOutputs) {
+  options_.record_path = out_ / "session.frec";
+  options_.out_dir = out_ / "recorded";
+  (void)run_session(options_);
+  const std::string good = read_file(out_ / "session.frec");
+  options_.record_path.clear();
+  options_.out_dir = out_;
+  write_earlier_outputs();
+
+  std::ofstream(out_ / "cut.frec", std::ios::binary) << good.substr(0, good.size() - 3);
+  options_.replay_path = out_ / "cut.frec";
+  std::string error = refusal();
+  EXPECT_NE(error.find((out_ / "cut.frec").string()), std::string::npos) << error;
+  EXPECT_NE(error.find("at byte offset"), std::string::npos) << error;
+  EXPECT_NE(error.find("truncated"), std::string::npos) << error;
+
+  std::string wrong_version = good;
+  wrong_version[8] = 9;
+  std::ofstream(out_ / "v9.frec", std::ios::binary) << wrong_version;
+  options_.replay_path = out_ / "v9.frec";
+  error = refusal();
+  EXPECT_NE(error.find("version 9"), std::string::npos) << error;
+
+  options_.replay_path = out_ / "recorded" / "session.frec";
+  fs::rename(out_ / "session.frec", options_.replay_path);
+  options_.duration_s = 10.0;
+  error = refusal();
+  EXPECT_NE(error.find("longer than the recorded session"), std::string::npos) << error;
+
+  options_.duration_s = 0.0;
+  options_.lockstep = false;
+  options_.device = SessionDevice::kUsb;
+  error = refusal();
+  EXPECT_NE(error.find("--replay"), std::string::npos) << error;
+  fs::remove(out_ / "cut.frec");
+  fs::remove(out_ / "v9.frec");
+  fs::remove_all(out_ / "recorded");
+  expect_earlier_outputs_untouched();
+}
+
 }  // namespace
 }  // namespace fissure::session

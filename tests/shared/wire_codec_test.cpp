@@ -2,9 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "fissure/shared/wire_reassembler.hpp"
 #include "wire_test_messages.hpp"
@@ -162,23 +164,46 @@ TEST(WireCodec, RefusesWhatTheWireCannotCarry) {
 
 TEST(WireCodec, HelloRoundTripsWhateverItsVersion) {
   Hello sent;
-  sent.protocol_version = 513;  // a future version: the Hello layout is frozen, so it still decodes
+  sent.protocol_version = 513;  // a future version: the Hello's prefix is frozen, so it still decodes
   sent.role = Role::kHost;
-  sent.flags = kHelloPeerSeen;
+  sent.flags = kHelloPeerSeen | kHelloClosing;
   sent.session_id = 0xDEADBEEF;
   sent.publish_rate_hz = 250.0f;
+  sent.session_fingerprint = 0x0123456789ABCDEFull;
+  const std::string name = "clamp-vessel";
+  std::copy(name.begin(), name.end(), sent.scene_name.begin());
   FrameBatch batch;
   ASSERT_EQ(encode(sent, 9, batch), EncodeStatus::kOk);
   ASSERT_EQ(batch.count, 1u);
-  EXPECT_EQ(batch.frames[0].length, 20);
+  EXPECT_EQ(batch.frames[0].length, 64);  // 52 B body + 4 B CRC + 4 B header, padded
   Reassembler reassembler;
   ASSERT_EQ(deliver(reassembler, batch), MessageType::kHello);
   const Hello& got = reassembler.hello();
   EXPECT_EQ(got.protocol_version, 513);
   EXPECT_EQ(got.role, Role::kHost);
-  EXPECT_EQ(got.flags, kHelloPeerSeen);
+  EXPECT_EQ(got.flags, kHelloPeerSeen | kHelloClosing);
   EXPECT_EQ(got.session_id, 0xDEADBEEFu);
   EXPECT_EQ(got.publish_rate_hz, 250.0f);
+  EXPECT_EQ(got.session_fingerprint, 0x0123456789ABCDEFull);
+  EXPECT_STREQ(got.scene_name.data(), "clamp-vessel");
+}
+
+TEST(WireCodec, AVersionTwoHelloIsTheFrozenPrefixAndStillDecodes) {
+  // A peer of the previous release sends the 12-byte Hello: it decodes, so the handshake can
+  // name both versions instead of dropping it as malformed.
+  Hello sent;
+  sent.protocol_version = 2;
+  sent.role = Role::kRt;
+  sent.session_id = 77;
+  sent.session_fingerprint = 0xFFFF;  // not on the wire before version 3
+  FrameBatch batch;
+  ASSERT_EQ(encode(sent, 1, batch), EncodeStatus::kOk);
+  EXPECT_EQ(batch.frames[0].length, 20);
+  Reassembler reassembler;
+  ASSERT_EQ(deliver(reassembler, batch), MessageType::kHello);
+  EXPECT_EQ(reassembler.hello().protocol_version, 2);
+  EXPECT_EQ(reassembler.hello().session_id, 77u);
+  EXPECT_EQ(reassembler.hello().session_fingerprint, 0u);
 }
 
 TEST(CanFdFrame, PadsToValidDataLengths) {
@@ -232,8 +257,8 @@ TEST(CanFdBusTime, PerMessageFiguresOfTheProtocolDocument) {
   EXPECT_NEAR(message_bus_time_us(batch, false), 139.6, 0.05);
   EXPECT_NEAR(message_bus_time_us(batch, true), 169.4, 0.05);
   ASSERT_EQ(encode(Hello{}, 0, batch), EncodeStatus::kOk);
-  EXPECT_NEAR(message_bus_time_us(batch, false), 69.2, 0.05);
-  EXPECT_NEAR(message_bus_time_us(batch, true), 81.4, 0.05);
+  EXPECT_NEAR(message_bus_time_us(batch, false), 139.6, 0.05);
+  EXPECT_NEAR(message_bus_time_us(batch, true), 169.4, 0.05);
 }
 
 }  // namespace

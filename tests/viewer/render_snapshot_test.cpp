@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <vector>
 
 #include "fissure/host_sim/scene_loader.hpp"
 
@@ -34,6 +35,38 @@ TEST(RenderModel, MatchesTheSettledSimulation) {
   EXPECT_NEAR(model.part_mesh.vertices[7].y(), 0.001F, 1e-6F);
   EXPECT_NEAR(model.part_mesh.vertices[7].z(), 0.03F, 1e-6F);
   EXPECT_FALSE(model.has_handle);
+}
+
+TEST(RenderModel, AThreeMillimetreDentIsTheStoryNotTheWholeBallsSag) {
+  // The case: the colour scale must show a 3 mm dent, not make the whole ball's motion
+  // the story.
+  host::HostSimulation sim(scene_named("spatula-sphere"));
+  sim.settle(1.0);
+  const RenderModel model = make_render_model(sim);
+  host::ToolPose pose = host::to_tool_pose(sim.scene().trajectory.start);
+  const auto max_displacement_m = [&] {
+    float max = 0.0F;
+    for (std::size_t i = 0; i < model.soft_rest_world_m.size(); ++i) {
+      max = std::max(max, (sim.node_positions_world_m()[i].cast<float>() - model.soft_rest_world_m[i]).norm());
+    }
+    return max;
+  };
+  for (int step = 0; step < 400 && max_displacement_m() < 0.003F; ++step) {
+    pose.position_world_m.y() -= 0.0001;  // 0.1 m/s at the 1 kHz host step
+    (void)sim.step(pose);
+  }
+  ASSERT_GE(max_displacement_m(), 0.003F);
+  std::vector<float> fractions;
+  for (std::size_t i = 0; i < model.soft_rest_world_m.size(); ++i) {
+    fractions.push_back(deformation_fraction(model, i, sim.node_positions_world_m()[i].cast<float>()));
+  }
+  std::sort(fractions.begin(), fractions.end());
+  EXPECT_GE(fractions.back(), 0.45F) << "a 3 mm dent must read about half-way to red (full scale "
+                                     << model.deformation_full_scale_m * 1e3F << " mm)";
+  // Pressing the top squashes and pushes the whole ball (the median node moves ~1.2 mm): the dent
+  // must still read at least twice as red as the median node.
+  EXPECT_GE(fractions.back(), 2.0F * fractions[fractions.size() / 2]) << "median " << fractions[fractions.size() / 2];
+  EXPECT_LE(model.deformation_full_scale_m, 0.0066F);
 }
 
 TEST(RenderModel, ClampHasTwoJawsAndAHandle) {

@@ -14,9 +14,9 @@
 namespace fissure::viewer {
 namespace {
 
-// The subject's displacement that reads fully red: 0.4 of its smallest half-size (see
+// The subject's displacement that reads fully red: 0.12 of its smallest half-size (see
 // RenderModel::deformation_full_scale_m).
-constexpr float kDeformationFullScaleFraction = 0.4F;
+constexpr float kDeformationFullScaleFraction = 0.12F;
 // Force arrow: 20 N (the top of the paper scenes' forces) is drawn one subject radius long.
 constexpr float kForceArrowRadiusFractionPerNewton = 0.05F;
 
@@ -86,6 +86,11 @@ RenderModel make_render_model(host::HostSimulation& sim) {
   model.deformation_full_scale_m = kDeformationFullScaleFraction * std::max(half.minCoeff(), 1e-3F);
   model.force_arrow_m_per_n = kForceArrowRadiusFractionPerNewton * model.focus_radius_m;
   return model;
+}
+
+float deformation_fraction(const RenderModel& model, std::size_t node, const Eigen::Vector3f& p_world_m) noexcept {
+  if (node >= model.soft_rest_world_m.size()) return 0.0F;
+  return std::clamp((p_world_m - model.soft_rest_world_m[node]).norm() / model.deformation_full_scale_m, 0.0F, 1.0F);
 }
 
 void capture_snapshot(const host::HostSimulation& sim, RenderSnapshot& out) noexcept {

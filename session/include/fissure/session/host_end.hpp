@@ -32,6 +32,8 @@ struct HostEndOutcome {
   double paused_s = 0.0;
   int crossed_nodes_max = 0;
   double host_force_max_n = 0.0;
+  bool rt_closed = false;  ///< rt_core said goodbye (it stopped cleanly)
+  bool rt_lost = false;    ///< rt_core silent at the end without a goodbye (crash, kill, cut link)
   bool interrupted = false;
 };
 

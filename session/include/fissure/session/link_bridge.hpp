@@ -42,6 +42,7 @@ struct BridgeStatus {
   const char* error = "";          ///< the handshake's one-line error when failed
   TimeNs peer_data_age_ns = transport::kNeverReceived;  ///< host end: DeviceState age; rt end: proxy age
   bool peer_silent = true;         ///< no peer data within the silence bound (or never any)
+  bool peer_closed = false;        ///< the peer said goodbye: it stopped cleanly (not a crash or a cut link)
   std::uint64_t messages_in = 0;   ///< whole data messages received and forwarded
   std::uint64_t messages_out = 0;  ///< data messages published to the wire
   std::uint64_t frames_discarded = 0;    ///< reassembler frame-level discards
@@ -67,6 +68,12 @@ class LinkBridge {
   /// host end, one pump: the newest DeviceState from the wire goes to the host; the newest
   /// proxy the host published goes to the wire.
   void pump_host(DeviceStateExchange& to_host, ProxyExchange& from_host) noexcept;
+
+  /// Says goodbye to the peer (a closing Hello, kGoodbyeRepeats times): call it when this end
+  /// stops cleanly, on the thread that pumps the bridge (or after it has stopped).
+  void close() noexcept;
+  /// A lost datagram must not turn a clean exit into a "lost link" report at the peer.
+  static constexpr int kGoodbyeRepeats = 3;
 
   [[nodiscard]] BridgeStatus status() const noexcept;
   [[nodiscard]] bool established() const noexcept { return endpoint_.established(); }

@@ -20,6 +20,9 @@ struct RtEndOptions {
   std::string transport;                ///< can:IFACE or udp:HOST:PORT (this box's address)
   bool usb_device = false;              ///< the USB Falcon; false: SimFalcon
   DeviceMapping device_mapping{};       ///< the scene's (the host must run the same scene)
+  /// The scene's name; with it the handshake refuses a host running another scene or mapping
+  /// (wire::session_fingerprint). Empty (no --scene): not checked, and said so.
+  std::string scene_name;
   std::optional<HandScript> hand;       ///< SimFalcon's scripted hand (none: the grip is left free)
   double rate_hz = 1000.0;              ///< rt tick rate [Hz]
   double seconds = 0.0;                 ///< run this long, then ramp out; 0 = until interrupted
@@ -40,6 +43,8 @@ struct RtEndOutcome {
   /// end; -1 when it was live at the end or never connected.
   double host_lost_at_s = -1.0;
   std::uint64_t host_losses = 0;        ///< times the host went silent after being live
+  /// Session time the host said goodbye (it stopped cleanly); -1 when it did not.
+  double host_closed_at_s = -1.0;
   std::uint64_t proxies_used = 0;
   double force_max_n = 0.0;
   std::uint64_t frames_discarded = 0;
@@ -52,9 +57,10 @@ struct RtEndOutcome {
 };
 
 /// Runs the rt end and prints its one-line summary on stdout (the link: never established,
-/// established at t, host silent from t). Throws SessionError when the set-up fails (device,
-/// carrier, rt config, an enforced real-time policy refused), the host was refused by the
-/// handshake, or no host ever connected.
+/// established at t, closed cleanly by the host at t, host silent from t). Throws SessionError
+/// when the set-up fails (device, carrier, rt config, an enforced real-time policy refused),
+/// the host was refused by the handshake (another protocol version, scene or mapping), no host
+/// ever connected, or the link was lost (the host went silent without closing) at the end.
 RtEndOutcome run_rt_end(const RtEndOptions& options);
 
 }  // namespace fissure::session

@@ -45,6 +45,7 @@ inline RtEndOptions rt_end_options(const RtEndArguments& arguments, const char* 
   if (!arguments.scene.empty()) {
     const config::RtSessionConfig scene = config::load_rt_session_config(config::resolve_scene_path(arguments.scene));
     options.device_mapping = scene.device_mapping;
+    options.scene_name = scene.scene_name;
     options.hand = scene.hand;
   }
   options.rate_hz = arguments.rate_hz;

@@ -3,6 +3,7 @@
 // host status), the summary figures docs/session.md explains (crossed_nodes_max, faults, overruns,
 // force_max_n, proxy_age_ms {median, p99}, energy_j) and a status line. Runs on the session's
 // main thread (not the rt thread): it may allocate and write files.
+#include <array>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -42,6 +43,8 @@ struct SessionFigures {
   std::uint64_t overruns = 0;
   std::uint64_t fault_ticks = 0;           ///< ticks with any RtFaultBits fault bit set
   std::uint32_t fault_bits_seen = 0;       ///< OR of every fault bit seen
+  /// Ticks with each flag bit (fault_bits 16..20: not faults, rt_core/faults.hpp), by bit − 16.
+  std::array<std::uint64_t, 5> flag_ticks{};
   std::uint64_t telemetry_samples = 0;
   TimeNs first_tick_time_ns = 0;           ///< loop clock time of the first / last sample
   TimeNs last_tick_time_ns = 0;

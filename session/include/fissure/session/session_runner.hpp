@@ -50,6 +50,12 @@ struct SessionOptions {
   int frame_every = 10;
   int frame_width_px = 960;
   int frame_height_px = 720;
+  /// --record: every device exchange goes to this device recording (falcon_hw/
+  /// device_recording.hpp, docs/session.md "Device recordings"), staged like the other outputs.
+  std::filesystem::path record_path;
+  /// --replay: the device answers from this recording instead of SimFalcon (ReplayDevice). The
+  /// session lasts as long as the recorded one unless --duration says less.
+  std::filesystem::path replay_path;
   /// Set from a signal handler: ramp out and stop (checked ~every 10 ms in real time, every
   /// host step in lockstep).
   const std::atomic<bool>* interrupt = nullptr;

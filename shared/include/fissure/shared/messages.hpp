@@ -23,7 +23,9 @@ namespace fissure {
 /// Version of the layouts below and of the wire codec built on them. The transport
 /// handshake refuses a peer with a different version (naming both).
 /// 2: DeviceState::status_flags bits 24..31 carry the position epoch (below).
-inline constexpr std::uint16_t kProtocolVersion = 2;
+/// 3: the Hello carries the session fingerprint and scene name, and a closing flag
+///    (wire_codec.hpp, wire_handshake.hpp).
+inline constexpr std::uint16_t kProtocolVersion = 3;
 
 /// One patch per tool face or jaw is enough for the paper's tools (spatula: 2 faces,
 /// clamp: 2 jaws × 2 faces); 8 leaves room for a convex tool's rim.

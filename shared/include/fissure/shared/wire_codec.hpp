@@ -47,20 +47,32 @@ const char* to_string(Role role) noexcept;
 
 enum HelloFlags : std::uint8_t {
   kHelloPeerSeen = 1u << 0,  ///< the sender has received a compatible Hello from us
+  kHelloClosing = 1u << 1,   ///< the sender is stopping cleanly: no more data will follow
 };
 
-/// Handshake message. Its byte layout never changes with kProtocolVersion, so a peer of any
-/// version can read it and report the mismatch with both version numbers.
+/// Bytes of the scene name a Hello carries (zero-padded; a longer name is cut).
+inline constexpr std::size_t kHelloSceneNameBytes = 32;
+/// The first protocol version whose Hello carries the fingerprint and scene name.
+inline constexpr std::uint16_t kHelloFingerprintVersion = 3;
+
+/// Handshake message. Its first 12 bytes (version, role, flags, session id, rate) never change
+/// with kProtocolVersion, so a peer of any version can read them and report a mismatch with both
+/// version numbers; the length follows from the version (12 body bytes before version 3, 52 from it).
 struct Hello {
   std::uint16_t protocol_version = kProtocolVersion;
   Role role = Role::kRt;
   std::uint8_t flags = 0;        ///< HelloFlags
   std::uint32_t session_id = 0;  ///< random per process start: a new id means the peer restarted
   float publish_rate_hz = 0.0f;  ///< rate at which the sender publishes its data messages
+  /// What the sender runs: session_fingerprint(scene name, device mapping); 0 = not checked.
+  std::uint64_t session_fingerprint = 0;
+  std::array<char, kHelloSceneNameBytes> scene_name{};  ///< for the mismatch message
 };
 
 // Body sizes (before the CRC). Counted in docs/wire_protocol.md field by field.
-inline constexpr std::size_t kHelloBodyBytes = 12;
+/// The frozen prefix: a Hello of versions 1 and 2 is only this.
+inline constexpr std::size_t kHelloPrefixBodyBytes = 12;
+inline constexpr std::size_t kHelloBodyBytes = kHelloPrefixBodyBytes + 8 + kHelloSceneNameBytes;
 inline constexpr std::size_t kDeviceStateBodyBytes = 52;
 inline constexpr std::size_t kProxyFixedBodyBytes = 18;
 inline constexpr std::size_t kPatchBodyBytes = 69;
@@ -129,6 +141,12 @@ bool crc_matches(std::uint8_t version, MessageType type, std::uint8_t transfer_i
 // Body decoders: `message` holds at least the type's message bytes (CRC already checked).
 void decode_device_state(const std::uint8_t* message, DeviceState& out) noexcept;
 void decode_contact_proxy(const std::uint8_t* message, ContactProxy& out) noexcept;
+/// Reads the body's length from its version (the first two bytes): the prefix before
+/// kHelloFingerprintVersion, the whole Hello from it.
 void decode_hello(const std::uint8_t* message, Hello& out) noexcept;
+/// Message bytes (body + CRC) of a Hello of `protocol_version`.
+constexpr std::size_t hello_message_bytes(std::uint16_t protocol_version) noexcept {
+  return (protocol_version < kHelloFingerprintVersion ? kHelloPrefixBodyBytes : kHelloBodyBytes) + kCrcBytes;
+}
 
 }  // namespace fissure::wire

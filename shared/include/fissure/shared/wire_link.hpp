@@ -151,6 +151,8 @@ struct LinkConfig {
   /// tenth of a second; ten 20-byte Hello frames a second use < 0.1 % of a 1/5 Mbit/s bus.
   TimeNs hello_period_ns = 100'000'000;
   LinkReceiverConfig receiver{};
+  /// What this end runs (wire::session_identity); the handshake refuses a peer running another.
+  wire::SessionIdentity identity{};
 };
 
 class LinkEndpoint {
@@ -164,6 +166,10 @@ class LinkEndpoint {
 
   wire::EncodeStatus publish(const DeviceState& state) noexcept { return sender_.publish(state); }
   wire::EncodeStatus publish(const ContactProxy& proxy) noexcept { return sender_.publish(proxy); }
+
+  /// Says goodbye: a Hello with kHelloClosing, sent now (call it when stopping cleanly, so the
+  /// peer reports "closed by the peer" instead of a lost link). Best effort, like every frame.
+  void close() noexcept;
 
   [[nodiscard]] bool established() const noexcept { return handshake_.state() == wire::HandshakeState::kEstablished; }
   [[nodiscard]] const wire::Handshake& handshake() const noexcept { return handshake_; }

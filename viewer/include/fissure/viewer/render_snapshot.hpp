@@ -84,10 +84,12 @@ struct RenderModel {
   std::string scene_name;
   std::vector<std::array<int, 3>> soft_triangles;  ///< indices into the snapshot's nodes (CCW from outside)
   std::vector<Eigen::Vector3f> soft_rest_world_m;  ///< the settled shape: displacement from it is coloured
-  /// Displacement from rest drawn fully red [m]: 0.4 of the soft body's smallest half-size (2 cm
-  /// for the paper's 5 cm sphere: a 1 cm press reads half-way, gravity sag stays blue). Plain
-  /// displacement, not strain: Bullet's kLST = 1 links hardly stretch, the body bends instead.
-  float deformation_full_scale_m = 0.02F;
+  /// Displacement from the settled shape drawn fully red [m]: 0.12 of the soft body's smallest
+  /// half-size (≈ 6 mm for the paper's 5 cm sphere: a 3 mm dent reads half-way to red, over
+  /// twice as red as the rest of the ball, which the press squashes and pushes by ~1 mm; deeper
+  /// presses saturate in the dent and the red area shows its extent). Plain displacement, not
+  /// strain: Bullet's kLST = 1 links hardly stretch, the body bends instead.
+  float deformation_full_scale_m = 0.006F;
   DrawMesh part_mesh;        ///< each collidable part (spatula box / convex mesh / one jaw), part frame
   bool has_handle = false;   ///< clamp: the handle box, tool frame (drawn, never collides)
   DrawMesh handle_mesh;
@@ -98,6 +100,10 @@ struct RenderModel {
   /// Force arrow length per newton [m/N]: 20 N is one subject radius.
   float force_arrow_m_per_n = 0.0025F;
 };
+
+/// Where soft node `node`, now at `p_world_m`, sits on the deformation colour map: 0 at its
+/// settled position (blue) → 1 at deformation_full_scale_m or more (red).
+[[nodiscard]] float deformation_fraction(const RenderModel& model, std::size_t node, const Eigen::Vector3f& p_world_m) noexcept;
 
 /// Builds the picture's model from a simulation whose soft body has settled (its current node
 /// positions become the rest shape). Throws std::invalid_argument when the soft body has more
