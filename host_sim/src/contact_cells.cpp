@@ -11,14 +11,9 @@ LeverResult run_lever_hold(const SceneDescription& scene, SceneCollisionMethod m
   const PlungeTool& blade = plunge_tools()[2];
   HostSimulation sim(scene, method);
   const double dt = scene.simulation.time_step_s;
-  ToolPose pose = to_tool_pose(scene.trajectory.start);
-  pose.position_world_m.y() = 0.2;
-  (void)sim.step(pose);
-  sim.settle(kPlungeSettle_s);
-  const double top_m = sim.soft_bounds_world_m().max().y();
-  pose.position_world_m.y() = top_m + kPlungeStartClearance_m + blade.leading_half_m;
-  const double end_y = top_m - kPlungeDepth_m + blade.leading_half_m;
-  (void)sim.step(pose);
+  const PlungeStart start = settle_and_place_above(sim, scene, blade.leading_half_m);
+  ToolPose pose = start.pose;
+  const double end_y = start.end_y_m;
   LeverResult result;
   auto record = [&](const HostStepResult& r) {
     result.crossed_nodes = std::max(result.crossed_nodes, r.crossing.crossed_nodes);

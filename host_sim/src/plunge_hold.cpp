@@ -75,21 +75,29 @@ HoldForceStats hold_force_stats(const std::vector<double>& force_n) {
   return stats;
 }
 
+PlungeStart settle_and_place_above(HostSimulation& sim, const SceneDescription& scene, double leading_half_m) {
+  // Start well clear, settle, then find the soft surface's top.
+  PlungeStart start;
+  start.pose = to_tool_pose(scene.trajectory.start);
+  start.pose.position_world_m.y() = 0.2;
+  (void)sim.step(start.pose);
+  sim.settle(kPlungeSettle_s);
+  const double top_m = sim.soft_bounds_world_m().max().y();
+  start.pose.position_world_m.y() = top_m + kPlungeStartClearance_m + leading_half_m;
+  start.end_y_m = top_m - kPlungeDepth_m + leading_half_m;
+  // Put the tool at the start pose first (out of contact): plunging straight from the settle
+  // pose (0.2 m) would make the first plunge step a ~0.12 m jump, well above the nominal speed.
+  (void)sim.step(start.pose);
+  return start;
+}
+
 PlungeHoldResult run_plunge_hold(const SceneDescription& scene, SceneCollisionMethod method, double speed_m_s, double leading_half_m,
                                  double hold_s, bool count_cut_triangles, const HoldStepObserver& on_hold_step) {
   HostSimulation sim(scene, method);
   const double dt = scene.simulation.time_step_s;
-  // Start well clear, settle, then find the soft surface's top.
-  ToolPose pose = to_tool_pose(scene.trajectory.start);
-  pose.position_world_m.y() = 0.2;
-  (void)sim.step(pose);
-  sim.settle(kPlungeSettle_s);
-  const double top_m = sim.soft_bounds_world_m().max().y();
-  pose.position_world_m.y() = top_m + kPlungeStartClearance_m + leading_half_m;
-  const double end_y = top_m - kPlungeDepth_m + leading_half_m;
-  // Put the tool at the start pose first (out of contact): plunging straight from the settle
-  // pose (0.2 m) would make the first plunge step a ~0.12 m jump, well above the nominal speed.
-  (void)sim.step(pose);
+  const PlungeStart start = settle_and_place_above(sim, scene, leading_half_m);
+  ToolPose pose = start.pose;
+  const double end_y = start.end_y_m;
   PlungeHoldResult result;
   auto record = [&](const HostStepResult& r) {
     result.crossed_nodes = std::max(result.crossed_nodes, r.crossing.crossed_nodes);

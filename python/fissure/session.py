@@ -39,6 +39,7 @@ TRACE_COLUMNS = {
     "host_time_s": "s, host simulated time of the newest host status",
     "host_force_n": "N", "host_contacts": "count (int)", "host_crossed_nodes": "count (int)",
     "host_penetration_m": "m",
+    "host_jaw_gap_m": "m, the jaw gap the host applied (clamp; 0 otherwise)",
 }
 _INT_COLUMNS = {"tick", "patches_in_contact", "proxy_sequence", "fault_bits", "overruns", "host_contacts", "host_crossed_nodes"}
 
@@ -68,7 +69,9 @@ class SessionResult:
 def run_session(scene, lockstep: bool = True, device: str = "sim", host_rate: Optional[float] = None,
                 rt_rate: float = 1000.0, method: Optional[str] = None, duration_s: Optional[float] = None,
                 settle_s: float = 1.0, out_dir: Optional[Union[str, os.PathLike]] = None, plot: bool = False,
-                passivity_controller: bool = True, status_line: bool = False) -> SessionResult:
+                passivity_controller: bool = True, status_line: bool = False,
+                record: Optional[Union[str, os.PathLike]] = None,
+                replay: Optional[Union[str, os.PathLike]] = None) -> SessionResult:
     """Runs one session: device (SimFalcon playing the scene's hand script, or the USB Falcon) +
     rt_core + the host simulation, as ``fissure run`` does.
 
@@ -79,7 +82,10 @@ def run_session(scene, lockstep: bool = True, device: str = "sim", host_rate: Op
     the method's contacts, so 'bullet' is refused with SessionError). duration_s [s]: None = the hand
     script's length. settle_s [s]: soft body settling before the session. out_dir: keep trace.csv,
     summary.json (and session.png with plot=True) there; None: a temporary directory, removed.
-    Raises SessionError (set-up failures), SceneError.
+    record: write every device exchange to this device recording (``fissure run --record``,
+    docs/session.md "Device recordings"). replay: the device answers from this recording instead
+    of SimFalcon (``--replay``); a lockstep replay reproduces the recorded session's trace.
+    Raises SessionError (set-up failures, a bad recording), SceneError.
     """
     from ._fissure import Scene  # noqa: PLC0415  (import cycle: the package imports this module)
 
@@ -90,7 +96,8 @@ def run_session(scene, lockstep: bool = True, device: str = "sim", host_rate: Op
     try:
         outcome = _fissure._run_session(
             scene, directory, lockstep, device, 0.0 if host_rate is None else float(host_rate), float(rt_rate), method,
-            0.0 if duration_s is None else float(duration_s), float(settle_s), plot, passivity_controller, status_line)
+            0.0 if duration_s is None else float(duration_s), float(settle_s), plot, passivity_controller, status_line,
+            "" if record is None else os.fspath(record), "" if replay is None else os.fspath(replay))
         result = SessionResult(trace=read_trace(outcome["trace_path"]), summary=json.loads(outcome["summary_json"]))
         if not temporary:
             result.trace_path = outcome["trace_path"]

@@ -22,7 +22,7 @@ void bind_session(py::module_& m) {
       "_run_session",
       [](const host::SceneDescription& scene, const std::string& out_dir, bool lockstep, const std::string& device, double host_rate_hz,
          double rt_rate_hz, const std::optional<std::string>& method, double duration_s, double settle_s, bool plot,
-         bool passivity_controller, bool status_line) {
+         bool passivity_controller, bool status_line, const std::string& record_path, const std::string& replay_path) {
         session::SessionOptions options;
         options.scene = scene;
         if (method) options.scene.simulation.collision_method = parse_method(*method);
@@ -37,6 +37,8 @@ void bind_session(py::module_& m) {
         options.plot = plot;
         options.passivity_controller = passivity_controller;
         options.status_line = status_line;
+        options.record_path = record_path;  // empty: no recording
+        options.replay_path = replay_path;  // empty: SimFalcon or the USB Falcon
         session::SessionOutcome outcome;
         {
           py::gil_scoped_release release;
@@ -51,7 +53,7 @@ void bind_session(py::module_& m) {
       },
       py::arg("scene"), py::arg("out_dir"), py::arg("lockstep"), py::arg("device"), py::arg("host_rate_hz"), py::arg("rt_rate_hz"),
       py::arg("method"), py::arg("duration_s"), py::arg("settle_s"), py::arg("plot"), py::arg("passivity_controller"),
-      py::arg("status_line"), "Internal: use fissure.run_session.");
+      py::arg("status_line"), py::arg("record_path"), py::arg("replay_path"), "Internal: use fissure.run_session.");
 }
 
 }  // namespace fissure::python

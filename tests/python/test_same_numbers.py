@@ -78,6 +78,22 @@ def test_session_matches_the_command_line(fissure_bin, tmp_path):
     assert trace["host_force_n"].max() > 0.1, "the session must reach contact"
 
 
+def test_a_recorded_session_replays_to_the_same_trace(tmp_path):
+    recording = tmp_path / "session.frec"
+    first = fissure.run_session("spatula-sphere", lockstep=True, duration_s=0.5, settle_s=0.3, out_dir=tmp_path / "recorded",
+                                record=recording)
+    assert recording.stat().st_size > 0
+    again = fissure.run_session("spatula-sphere", lockstep=True, settle_s=0.3, out_dir=tmp_path / "replayed", replay=recording)
+    assert (tmp_path / "replayed" / "trace.csv").read_bytes() == (tmp_path / "recorded" / "trace.csv").read_bytes()
+    assert again.summary["ticks"] == first.summary["ticks"] > 0
+
+
+def test_a_missing_recording_is_a_session_error(tmp_path):
+    with pytest.raises(fissure.SessionError) as error:
+        fissure.run_session("spatula-sphere", lockstep=True, settle_s=0.3, replay=tmp_path / "none.frec")
+    assert "none.frec" in str(error.value)
+
+
 def test_stress_case_matches_the_command_line(fissure_bin, tmp_path):
     case = fissure.stress_case_names()[0]
     report_path = tmp_path / "stress.json"

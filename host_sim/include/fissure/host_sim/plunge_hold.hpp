@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "fissure/host_sim/scene_description.hpp"
+#include "fissure/host_sim/thin_tool.hpp"
 
 namespace fissure::host {
 
@@ -53,6 +54,15 @@ struct PlungeTool {
 /// ball is an icosphere of that many faces (issue 22's second mesh: 1280) instead of the
 /// paper's 128-face shell. Loads shipped scenes (throws SceneError when they cannot be found).
 [[nodiscard]] SceneDescription plunge_scene(const PlungeTool& tool, int icosphere_faces = 0);
+
+/// Where a plunge starts: the tool kPlungeStartClearance_m above the settled soft surface, and
+/// the height of its origin once the leading face is kPlungeDepth_m below that surface [m, world y].
+struct PlungeStart {
+  ToolPose pose;
+  double end_y_m = 0.0;
+};
+/// Settles `sim` (kPlungeSettle_s, the tool well clear) and steps the tool to the start pose.
+[[nodiscard]] PlungeStart settle_and_place_above(HostSimulation& sim, const SceneDescription& scene, double leading_half_m);
 
 /// Statistics of |F(t)| over the hold, sampled every step and fitted by a least-squares line.
 /// All fractions of the mean force; zero when no contact is left (in_contact false).
