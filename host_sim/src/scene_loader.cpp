@@ -107,7 +107,7 @@ void read_anchors(const std::string& file, TableReader& t, SoftBodyDescription& 
   }
 }
 
-void read_soft_body(const std::string& file, TableReader& t, SoftBodyDescription& soft) {
+void read_soft_body(const std::string& file, TableReader& t, SoftBodyDescription& soft, const std::filesystem::path& base_dir) {
   const std::string shape = t.text("shape");
   if (shape == "sphere") {
     SoftSphere s;
@@ -143,8 +143,25 @@ void read_soft_body(const std::string& file, TableReader& t, SoftBodyDescription
     s.top_cells_count[0] = t.count("top_cells_x", 1, 1024);
     s.top_cells_count[1] = t.count("top_cells_z", 1, 1024);
     soft.shape = s;
+  } else if (shape == "mesh") {
+    SoftMesh m;
+    const std::string rel = t.text("mesh_path");
+    const std::filesystem::path full = std::filesystem::path(rel).is_absolute() ? std::filesystem::path(rel) : base_dir / rel;
+    m.mesh_path = full.lexically_normal().string();
+    m.offset_world_m = t.vec3("offset_world", "m", Vec3{0.0, 0.0, 0.0});
+    try {
+      SurfaceMesh mesh = read_soft_body_mesh(m.mesh_path);
+      for (Vec3& v : mesh.vertices_m) {
+        for (std::size_t k = 0; k < 3; ++k) v[k] += m.offset_world_m[k];
+      }
+      m.vertices_world_m = std::move(mesh.vertices_m);
+      m.triangles = std::move(mesh.triangles);
+    } catch (const std::exception& e) {
+      t.fail(t.line_for("mesh_path", ""), "mesh_path", std::string("unreadable mesh: ") + e.what());
+    }
+    soft.shape = std::move(m);
   } else {
-    t.fail(t.line_for("shape", ""), "shape", "'" + shape + "' is not one of: sphere, cylinder, slab");
+    t.fail(t.line_for("shape", ""), "shape", "'" + shape + "' is not one of: sphere, cylinder, slab, mesh");
   }
   soft.mass_kg = t.positive("mass", "kg");
   soft.linear_stiffness_ratio = t.in_range("linear_stiffness", "ratio", 1e-6, 1.0);
@@ -190,7 +207,7 @@ void read_tool(const std::string& file, TableReader& t, ToolDescription& tool, c
       const std::filesystem::path full = std::filesystem::path(rel).is_absolute() ? std::filesystem::path(rel) : base_dir / rel;
       tool.mesh_path = full.lexically_normal().string();
       try {
-        const ToolMesh mesh = read_tool_mesh_obj(tool.mesh_path);
+        const ToolMesh mesh = read_tool_mesh(tool.mesh_path);
         tool.mesh_vertices_tool_m = mesh.vertices_m;
         tool.mesh_triangles = mesh.triangles;
       } catch (const std::exception& e) {
@@ -278,7 +295,7 @@ SceneDescription parse(const toml::table& root, const std::string& file, const s
   }
   {
     TableReader t(file, *top.subtable("soft_body", true), "soft_body");
-    read_soft_body(file, t, scene.soft_body);
+    read_soft_body(file, t, scene.soft_body, base_dir);
   }
   {
     TableReader t(file, *top.subtable("tool", true), "tool");

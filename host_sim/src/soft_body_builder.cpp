@@ -1,11 +1,14 @@
 // Soft body meshes and their Bullet construction (soft_body_builder.hpp).
 #include "fissure/host_sim/soft_body_builder.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <unordered_set>
 #include <utility>
 
 #include <BulletDynamics/Dynamics/btRigidBody.h>
@@ -14,11 +17,17 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "fissure/host_sim/mesh_checks.hpp"
+#include "fissure/host_sim/mesh_file.hpp"
+
 namespace fissure::host {
 
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+// A soft mesh's triangle is degenerate when |(b − a) × (c − a)| is at most this fraction of the
+// squared mesh size (a sliver Bullet would give a NaN normal), as for a convex tool's nodes (thin_tool.cpp).
+constexpr double kDegenerateCrossRelative = 1e-12;
 
 Eigen::Vector3d e3(const Vec3& v) { return {v[0], v[1], v[2]}; }
 
@@ -35,6 +44,30 @@ void orient_outward(SurfaceMesh& mesh) {
 }
 
 }  // namespace
+
+btSoftBody* create_from_tri_mesh(btSoftBodyWorldInfo& world_info, const std::vector<btScalar>& xyz, const std::vector<std::array<int, 3>>& triangles) {
+  // btSoftBodyHelpers::CreateFromTriMesh's construction, step for step (nodes in index order,
+  // a link for each edge the first time a triangle runs it, in the order (c, a), (a, b), (b, c),
+  // the faces in order, then Bullet's own deterministic randomizeConstraints), with its
+  // vertices × vertices table of seen edges — 10 GB at 100k vertices, and an int overflow past
+  // 46,340 — replaced by a hash set of the edges.
+  const int count = static_cast<int>(xyz.size() / 3);
+  btAlignedObjectArray<btVector3> x;
+  x.resize(count);
+  for (int i = 0; i < count; ++i) x[i] = btVector3(xyz[3 * static_cast<std::size_t>(i)], xyz[3 * static_cast<std::size_t>(i) + 1], xyz[3 * static_cast<std::size_t>(i) + 2]);
+  auto* body = new btSoftBody(&world_info, count, count > 0 ? &x[0] : nullptr, nullptr);
+  std::unordered_set<std::uint64_t> seen;
+  seen.reserve(3 * triangles.size());
+  for (const auto& t : triangles) {
+    for (int j = 2, k = 0; k < 3; j = k++) {
+      const auto a = static_cast<std::uint32_t>(t[static_cast<std::size_t>(j)]), b = static_cast<std::uint32_t>(t[static_cast<std::size_t>(k)]);
+      if (seen.insert((static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b)).second) body->appendLink(t[static_cast<std::size_t>(j)], t[static_cast<std::size_t>(k)]);
+    }
+    body->appendFace(t[0], t[1], t[2]);
+  }
+  body->randomizeConstraints();
+  return body;
+}
 
 SurfaceMesh make_icosphere(const Vec3& center_m, double radius_m, int subdivisions) {
   const double phi = (1.0 + std::sqrt(5.0)) / 2.0;
@@ -140,6 +173,38 @@ SurfaceMesh make_slab(const SoftSlab& s) {
   return mesh;
 }
 
+SurfaceMesh make_organ_blob(int subdivisions) {
+  SurfaceMesh mesh = make_icosphere({0.0, 0.0, 0.0}, 1.0, subdivisions);  // unit directions, outward
+  // Radial and axis-wise scalings keep the surface star-shaped about the origin, so the sphere's
+  // outward winding stays outward.
+  constexpr double kHalfAxes_m[3] = {0.05, 0.025, 0.035};
+  constexpr double kUnderside = 0.75;        // flatter where it lies on its bed
+  constexpr double kDentDepth = 0.25;        // the dent pulls the +z pole in by a quarter
+  constexpr double kDentWidth2 = 0.18;       // its Gaussian width², in squared unit-sphere distance (~25°)
+  for (Vec3& v : mesh.vertices_m) {
+    const Eigen::Vector3d d = e3(v);
+    const double dent = 1.0 - kDentDepth * std::exp(-(d - Eigen::Vector3d::UnitZ()).squaredNorm() / kDentWidth2);
+    v = {kHalfAxes_m[0] * dent * d.x(), kHalfAxes_m[1] * (d.y() < 0.0 ? kUnderside : 1.0) * dent * d.y(), kHalfAxes_m[2] * dent * d.z()};
+  }
+  return mesh;
+}
+
+SurfaceMesh read_soft_body_mesh(const std::string& path) {
+  MeshFile file = read_mesh_file(path, kSoftMeshMaxTriangles);
+  Eigen::AlignedBox3d bounds;
+  for (const Vec3& v : file.vertices_m) bounds.extend(e3(v));
+  const double size_m = file.vertices_m.empty() || !bounds.diagonal().allFinite() ? 0.0 : bounds.diagonal().norm();
+  try {
+    check_closed_surface(file.vertices_m, file.triangles, kDegenerateCrossRelative * size_m * size_m);
+  } catch (const MeshDefect& defect) {
+    throw MeshError(describe(file, defect));
+  }
+  SurfaceMesh mesh;
+  mesh.vertices_m = std::move(file.vertices_m);
+  mesh.triangles = std::move(file.triangles);
+  return mesh;
+}
+
 btSoftBody* build_soft_body(btSoftBodyWorldInfo& world_info, const SoftBodyDescription& d) {
   btSoftBody* body = nullptr;
   std::vector<int> pinned;
@@ -161,6 +226,11 @@ btSoftBody* build_soft_body(btSoftBodyWorldInfo& world_info, const SoftBodyDescr
       mesh = make_icosphere(ico->center_world_m, ico->radius_m, subdivisions);
     } else if (const auto* cylinder = std::get_if<SoftCylinder>(&d.shape)) {
       mesh = make_cylinder(*cylinder);
+    } else if (const auto* file = std::get_if<SoftMesh>(&d.shape)) {
+      // Checked outward at load (read_soft_body_mesh): orient_outward's centroid test would be
+      // wrong for a body that is not convex.
+      mesh.vertices_m = file->vertices_world_m;
+      mesh.triangles = file->triangles;
     } else {
       mesh = make_slab(std::get<SoftSlab>(d.shape));
     }
@@ -169,10 +239,7 @@ btSoftBody* build_soft_body(btSoftBodyWorldInfo& world_info, const SoftBodyDescr
     for (const Vec3& v : mesh.vertices_m) {
       for (double c : v) xyz.push_back(static_cast<btScalar>(c));
     }
-    std::vector<int> tris;
-    tris.reserve(mesh.triangles.size() * 3);
-    for (const auto& t : mesh.triangles) tris.insert(tris.end(), t.begin(), t.end());
-    body = btSoftBodyHelpers::CreateFromTriMesh(world_info, xyz.data(), tris.data(), static_cast<int>(mesh.triangles.size()), true);
+    body = create_from_tri_mesh(world_info, xyz, mesh.triangles);
     pinned = mesh.pinned_vertices;
   }
   body->m_materials[0]->m_kLST = static_cast<btScalar>(d.linear_stiffness_ratio);

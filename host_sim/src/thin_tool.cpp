@@ -4,9 +4,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
+
+#include "fissure/host_sim/mesh_bvh.hpp"
 
 namespace fissure::host {
 namespace {
@@ -43,24 +47,6 @@ std::vector<Eigen::Vector2d> convex_hull_2d(std::vector<Eigen::Vector2d> points)
   }
   hull.resize(k - 1);
   return hull;
-}
-
-// Möller–Trumbore, two-sided; returns the ray parameter or +inf.
-double ray_triangle(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, const Eigen::Vector3d& a,
-                    const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
-  const Eigen::Vector3d e1 = b - a;
-  const Eigen::Vector3d e2 = c - a;
-  const Eigen::Vector3d pvec = dir.cross(e2);
-  const double det = e1.dot(pvec);
-  if (std::abs(det) < 1e-300) return std::numeric_limits<double>::infinity();
-  const double inv_det = 1.0 / det;
-  const Eigen::Vector3d tvec = origin - a;
-  const double u = tvec.dot(pvec) * inv_det;
-  if (u < -1e-12 || u > 1.0 + 1e-12) return std::numeric_limits<double>::infinity();
-  const Eigen::Vector3d qvec = tvec.cross(e1);
-  const double v = dir.dot(qvec) * inv_det;
-  if (v < -1e-12 || u + v > 1.0 + 1e-12) return std::numeric_limits<double>::infinity();
-  return e2.dot(qvec) * inv_det;
 }
 
 }  // namespace
@@ -187,24 +173,53 @@ ToolNodes ToolNodes::from_convex_mesh(const ConvexMeshToolShape& shape) {
     tri_b.push_back(b);
     tri_c.push_back(c);
   }
-  // Planes: merge coplanar triangles (a flat face is one plane), check convexity.
+  // Convexity: no vertex beyond any triangle's plane by more than tol_m (a box tree over the
+  // vertices answers each triangle in ~log n instead of a scan of every vertex).
+  const VertexTree vertex_tree(verts);
   for (std::size_t f = 0; f < tri_normal.size(); ++f) {
     const double offset = tri_normal[f].dot(tri_a[f]);
-    for (const auto& p : verts)
-      if (tri_normal[f].dot(p) - offset > tol_m)
-        throw std::invalid_argument("convex tool mesh: not convex (a vertex lies outside triangle " +
-                                    std::to_string(f) + "'s plane)");
+    const Eigen::Vector3d& n = tri_normal[f];
+    if (vertex_tree.find_beyond(n, offset + tol_m, [&](const Eigen::Vector3d& p) { return n.dot(p) - offset > tol_m; }) >= 0)
+      throw std::invalid_argument("convex tool mesh: not convex (a vertex lies outside triangle " + std::to_string(f) + "'s plane)");
+  }
+  // Planes: merge coplanar triangles (a flat face is one plane) — each triangle takes the FIRST
+  // plane (in creation order) whose normal is within 1 − 1e-9 in cosine and whose offset is
+  // within tol_m. Planes are hashed on a grid of (normal, offset) cells at least as wide as
+  // those tolerances, so every plane that can match lies in the 3^4 cells around the triangle's.
+  struct CellHash {
+    std::size_t operator()(const std::array<std::int64_t, 4>& k) const noexcept {
+      std::size_t h = 0;
+      for (const std::int64_t c : k) h = h * 0x9E3779B97F4A7C15ULL ^ static_cast<std::size_t>(c);
+      return h;
+    }
+  };
+  // |n − m| < 4.5e-5 when n·m > 1 − 1e-9 (unit normals): a 5e-5 cell per normal component.
+  constexpr double kNormalCell = 5e-5;
+  const double offset_cell = std::max(tol_m, std::numeric_limits<double>::min());
+  const auto cell_of = [&](const Eigen::Vector3d& n, double offset) {
+    return std::array<std::int64_t, 4>{static_cast<std::int64_t>(std::floor(n.x() / kNormalCell)), static_cast<std::int64_t>(std::floor(n.y() / kNormalCell)),
+                                       static_cast<std::int64_t>(std::floor(n.z() / kNormalCell)), static_cast<std::int64_t>(std::floor(offset / offset_cell))};
+  };
+  std::unordered_map<std::array<std::int64_t, 4>, std::vector<int>, CellHash> plane_cells;
+  for (std::size_t f = 0; f < tri_normal.size(); ++f) {
+    const double offset = tri_normal[f].dot(tri_a[f]);
+    const std::array<std::int64_t, 4> cell = cell_of(tri_normal[f], offset);
     int plane_index = -1;
-    for (std::size_t q = 0; q < tool.planes_.size(); ++q) {
-      if (tool.planes_[q].normal_tool.dot(tri_normal[f]) > 1.0 - 1e-9 &&
-          std::abs(tool.planes_[q].offset_m - offset) <= tol_m) {
-        plane_index = static_cast<int>(q);
-        break;
+    for (int d = 0; d < 81; ++d) {
+      std::array<std::int64_t, 4> near = cell;
+      for (int k = 0, code = d; k < 4; ++k, code /= 3) near[static_cast<std::size_t>(k)] += code % 3 - 1;
+      const auto it = plane_cells.find(near);
+      if (it == plane_cells.end()) continue;
+      for (const int q : it->second) {
+        if ((plane_index < 0 || q < plane_index) && tool.planes_[static_cast<std::size_t>(q)].normal_tool.dot(tri_normal[f]) > 1.0 - 1e-9 &&
+            std::abs(tool.planes_[static_cast<std::size_t>(q)].offset_m - offset) <= tol_m)
+          plane_index = q;
       }
     }
     if (plane_index < 0) {
       plane_index = static_cast<int>(tool.planes_.size());
       tool.planes_.push_back(ToolPlane{tri_normal[f], offset});
+      plane_cells[cell].push_back(plane_index);
     }
     tool.positions_tool_m_.push_back((tri_a[f] + tri_b[f] + tri_c[f]) / 3.0);
     tool.normals_tool_.push_back(tri_normal[f]);
@@ -212,25 +227,14 @@ ToolNodes ToolNodes::from_convex_mesh(const ConvexMeshToolShape& shape) {
   }
   // Pairing: a ray from each centroid opposite to its normal, limited to pairing_ray_limit_m;
   // the nearest other triangle hit gives the pair (paper Fig. 2: the limit stops rim nodes
-  // pairing across the edge).
+  // pairing across the edge). A box tree over the triangles visits only those near the ray.
   const std::size_t count = tri_normal.size();
   tool.pair_of_.assign(count, -1);
   if (shape.pairing_ray_limit_m > 0.0) {
     const double t_min = tol_m;  // skip the node's own plane (and coplanar neighbours)
+    const TriangleTree triangle_tree(tri_a, tri_b, tri_c);
     for (std::size_t i = 0; i < count; ++i) {
-      const Eigen::Vector3d origin = tool.positions_tool_m_[i];
-      const Eigen::Vector3d dir = -tri_normal[i];
-      double best_t = shape.pairing_ray_limit_m;
-      int best = -1;
-      for (std::size_t j = 0; j < count; ++j) {
-        if (j == i) continue;
-        const double t = ray_triangle(origin, dir, tri_a[j], tri_b[j], tri_c[j]);
-        if (t > t_min && t <= best_t) {
-          best_t = t;
-          best = static_cast<int>(j);
-        }
-      }
-      tool.pair_of_[i] = best;
+      tool.pair_of_[i] = triangle_tree.first_hit(tool.positions_tool_m_[i], -tri_normal[i], t_min, shape.pairing_ray_limit_m, static_cast<int>(i));
     }
   }
   tool.hull_vertices_tool_m_ = verts;

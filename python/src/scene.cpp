@@ -36,6 +36,7 @@ const char* tool_kind_name(host::ToolKind kind) {
 const char* soft_shape_name(const host::SoftBodyDescription& soft) {
   if (std::holds_alternative<host::SoftSphere>(soft.shape)) return "sphere";
   if (std::holds_alternative<host::SoftCylinder>(soft.shape)) return "cylinder";
+  if (std::holds_alternative<host::SoftMesh>(soft.shape)) return "mesh";
   return "slab";
 }
 

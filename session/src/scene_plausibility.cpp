@@ -83,6 +83,23 @@ void check_soft_body(const host::SceneDescription& scene, Findings& out) {
         break;
       }
     }
+  } else if (const auto* m = std::get_if<host::SoftMesh>(&soft.shape)) {
+    // The mesh's bounding box: a file in millimetres read as metres is 1000 times too large.
+    Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+    for (const Vec3& v : m->vertices_world_m) {
+      for (std::size_t k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], v[k]);
+        hi[k] = std::max(hi[k], v[k]);
+      }
+    }
+    const Vec3 size{hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+    for (double e : size) {
+      if (e < kSoftExtentMin_m || e > kSoftExtentMax_m) {
+        out.add("soft_body.mesh_path", "a mesh of " + vector_text(size, "m"),
+                "every extent 1 mm .. 0.5 m, a specimen on the Falcon's bench (a file in millimetres read as metres?)");
+        break;
+      }
+    }
   }
   if (soft.mass_kg < kSoftMassMin_kg || soft.mass_kg > kSoftMassMax_kg) {
     out.add("soft_body.mass_kg", number(soft.mass_kg) + " kg", "0.1 g .. 10 kg, a tissue specimen");

@@ -67,6 +67,18 @@ struct SoftSlab {
   std::array<int, 2> top_cells_count{16, 16};  ///< grid cells of the top face along x, z
 };
 
+/// A soft body from a closed surface mesh file (OBJ or STL, docs/scenes.md "Mesh files"): the
+/// file's vertices in metres, moved by offset_world_m, counter-clockwise seen from outside; the
+/// loader reads it and refuses a mesh that is open, non-manifold, inconsistently or inward
+/// oriented, degenerate, several surfaces or too large (read_soft_body_mesh). Built like the
+/// other shapes: btSoftBodyHelpers::CreateFromTriMesh, one link per edge.
+struct SoftMesh {
+  std::string mesh_path;                      ///< absolute path of the file (resolved at load)
+  Vec3 offset_world_m{0.0, 0.0, 0.0};         ///< where the file's origin goes in the world
+  std::vector<Vec3> vertices_world_m;         ///< the file's vertices + offset_world_m (loaded and checked at load)
+  std::vector<std::array<int, 3>> triangles;  ///< counter-clockwise seen from outside
+};
+
 /// Soft-body anchoring (tissue attached to its bed): every node whose REST position (the
 /// shape as built, before settling) lies in this world box, bounds included, is tied to the
 /// ground by a Bullet anchor (btSoftBody::appendAnchor). Anchored nodes keep their mass, so
@@ -77,7 +89,7 @@ struct SoftAnchorBox {
 };
 
 struct SoftBodyDescription {
-  std::variant<SoftSphere, SoftCylinder, SoftSlab> shape{SoftSphere{}};
+  std::variant<SoftSphere, SoftCylinder, SoftSlab, SoftMesh> shape{SoftSphere{}};
   double mass_kg = 0.1;
   double linear_stiffness_ratio = 0.5;     ///< Bullet material kLST ∈ (0, 1]
   double pressure_kpr = 0.0;               ///< Bullet config kPR (pressure coefficient), ≥ 0

@@ -3,7 +3,11 @@
 // on the edges): the paper's sphere (Bullet's own CreateEllipsoid, 128 faces), geodesic
 // icospheres for mesh refinement, a closed cylinder (the vessel) and a slab.
 #include <array>
+#include <cstddef>
+#include <string>
 #include <vector>
+
+#include <LinearMath/btScalar.h>
 
 #include "fissure/host_sim/scene_description.hpp"
 
@@ -24,6 +28,27 @@ struct SurfaceMesh {
 [[nodiscard]] SurfaceMesh make_icosphere(const Vec3& center_m, double radius_m, int subdivisions);
 [[nodiscard]] SurfaceMesh make_cylinder(const SoftCylinder& cylinder);
 [[nodiscard]] SurfaceMesh make_slab(const SoftSlab& slab);
+/// The shipped organ-like lobe (scenes/meshes/organ-blob.obj, written by `fissure sim
+/// --write-meshes`): an icosphere (20·4^subdivisions faces) mapped onto an ellipsoid of
+/// 100 × 50 × 70 mm, flattened to 3/4 underneath, with a smooth dent on its +z side (a kidney's
+/// hilum): closed, outward, not convex. Centred on the origin, metres.
+[[nodiscard]] SurfaceMesh make_organ_blob(int subdivisions);
+
+/// The most triangles a soft-body mesh may have: the sphere's faces_count bound in the scene
+/// loader (400,000), the largest body the host step has been run with.
+inline constexpr std::size_t kSoftMeshMaxTriangles = 400'000;
+
+/// Reads a soft body's closed surface mesh (OBJ or STL by extension, mesh_file.hpp) and checks
+/// it: closed, manifold, consistently oriented and facing outwards, one surface, no degenerate
+/// triangle (|(b − a) × (c − a)| ≤ 1e-12 of the squared mesh size), at most
+/// kSoftMeshMaxTriangles. Throws MeshError naming the file, the element (triangle / vertex, its
+/// line in a text format) and the reason.
+[[nodiscard]] SurfaceMesh read_soft_body_mesh(const std::string& path);
+
+/// btSoftBodyHelpers::CreateFromTriMesh(…, randomizeConstraints = true) in linear memory and
+/// time: the same nodes, links, faces and their order (xyz: 3 coordinates per vertex).
+[[nodiscard]] btSoftBody* create_from_tri_mesh(btSoftBodyWorldInfo& world_info, const std::vector<btScalar>& xyz,
+                                               const std::vector<std::array<int, 3>>& triangles);
 
 /// Builds the scene's soft body (not yet added to a world) and applies its material and
 /// config (kLST, kPR, kVC, kDP, kDF, piterations, margin, mass; kKHR = kCHR = 1, BRIEF §3).
