@@ -5,7 +5,7 @@
 //   read  — read_tool_mesh: parse the file and run every check (check_tool_mesh);
 //   check — check_tool_mesh alone on the parsed mesh (part of read);
 // the 41k and 362k tools again as binary and ASCII STL (read and check only: the rest is the
-// OBJ row's); and soft bodies from the organ-like lobe (make_organ_blob) at 1280, 20480 and
+// OBJ row's), and tilted to the axes (tilted_row); and soft bodies from the organ-like lobe (make_organ_blob) at 1280, 20480 and
 // 327680 triangles: read = read_soft_body_mesh (parse + closed-surface checks), build =
 // build_soft_body (the Bullet body with its links, as a scene's world builds it).
 //   nodes — ToolNodes::from_convex_mesh: a node per triangle, coplanar planes merged, pairing rays;
@@ -29,7 +29,10 @@
 #include <fstream>
 #include <memory>
 
+#include <Eigen/Geometry>
+
 #include "fissure/host_sim/contact_metrics.hpp"
+#include "fissure/host_sim/mesh_checks.hpp"
 #include "fissure/host_sim/soft_body_builder.hpp"
 #include "fissure/host_sim/thin_tool.hpp"
 #include "fissure/host_sim/tool_mesh_io.hpp"
@@ -171,6 +174,22 @@ nlohmann::json stl_row(const SpatulaSize& size, const fs::path& dir, bool binary
   return row;
 }
 
+// The spatula turned 0.3 rad about (1, 2, 3): its flat faces tilted to the axes, the case a
+// box around coplanar points sticks out of their plane (bench rows: the convexity check and
+// the nodes stage, which need no thin axis along y).
+nlohmann::json tilted_row(const SpatulaSize& size) {
+  host::ConvexMeshToolShape shape = spatula(size);
+  const Eigen::Quaterniond turn(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1.0, 2.0, 3.0).normalized()));
+  for (auto& v : shape.vertices_tool_m) v = turn * v;
+  std::printf("%-14s %-9s %9zu tris  ", (std::string("spatula-") + size.name).c_str(), "tilted", shape.triangles.size());
+  std::fflush(stdout);
+  const double check_s = seconds_of([&] { host::check_convex(shape.vertices_tool_m, shape.triangles, 1e-5 * 0.065); });
+  const double nodes_s = seconds_of([&] { (void)host::ToolNodes::from_convex_mesh(shape); });
+  std::printf("convexity check %8.3f s  nodes %8.3f s\n", check_s, nodes_s);
+  return nlohmann::json{{"mesh", std::string("spatula-") + size.name + "-tilted"}, {"triangles", shape.triangles.size()},
+                        {"check_s", check_s}, {"nodes_s", nodes_s}};
+}
+
 nlohmann::json soft_row(int subdivisions, const fs::path& dir) {
   const host::SurfaceMesh blob = host::make_organ_blob(subdivisions);
   const fs::path path = dir / ("organ-blob-" + std::to_string(subdivisions) + ".obj");
@@ -220,6 +239,12 @@ nlohmann::json run_bench_mesh(const BenchMeshOptions& options) {
     stl.push_back(stl_row(size, dir, false));
   }
   out["tool_meshes_stl"] = stl;
+  nlohmann::json tilted = nlohmann::json::array();
+  for (const SpatulaSize& size : kSizes) {
+    if (std::string(size.name) == "1k" || (options.quick && std::string(size.name) == "362k")) continue;
+    tilted.push_back(tilted_row(size));
+  }
+  out["tool_meshes_tilted"] = tilted;
   std::printf("soft-body meshes (organ-like lobe):\n");
   nlohmann::json soft = nlohmann::json::array();
   for (const int subdivisions : {3, 5, 7}) {

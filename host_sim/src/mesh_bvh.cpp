@@ -6,6 +6,8 @@
 #include <limits>
 #include <numeric>
 
+#include <Eigen/Eigenvalues>
+
 namespace fissure::host {
 namespace {
 
@@ -71,7 +73,46 @@ int BoxTree::build(int begin, int end, const std::vector<Eigen::Vector3d>& centr
 }
 
 VertexTree::VertexTree(const std::vector<Eigen::Vector3d>& vertices)
-    : vertices_(vertices), tree_(vertices, vertices), slack_m_(kSlackRelative * mesh_size(vertices)) {}
+    : vertices_(vertices), tree_(vertices, vertices), slack_m_(kSlackRelative * mesh_size(vertices)) {
+  slabs_.resize(tree_.nodes().size());
+  if (!tree_.nodes().empty()) (void)fill_slabs(0);
+}
+
+// Each node's points are items [begin, end) with begin = the first leaf's `first` below it: a
+// node's range is its left child's followed by its right child's. Every level visits each point
+// once: n log n.
+int VertexTree::fill_slabs(int index) {
+  const BoxTree::Node& node = tree_.nodes()[static_cast<std::size_t>(index)];
+  int begin = 0, end = 0;
+  if (node.count > 0) {
+    begin = node.first;
+    end = node.first + node.count;
+  } else {
+    int walk = index;
+    while (tree_.nodes()[static_cast<std::size_t>(walk)].count <= 0) walk = tree_.nodes()[static_cast<std::size_t>(walk)].first;
+    begin = tree_.nodes()[static_cast<std::size_t>(walk)].first;
+    (void)fill_slabs(node.first);
+    end = fill_slabs(-node.count);
+  }
+  Slab& slab = slabs_[static_cast<std::size_t>(index)];
+  const auto point = [&](int i) -> const Eigen::Vector3d& { return vertices_[static_cast<std::size_t>(tree_.items()[static_cast<std::size_t>(i)])]; };
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (int i = begin; i < end; ++i) centre += point(i);
+  centre /= static_cast<double>(end - begin);
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (int i = begin; i < end; ++i) covariance += (point(i) - centre) * (point(i) - centre).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+  Eigen::Vector3d normal = solver.eigenvectors().col(0);  // eigenvalues ascending: the least spread
+  if (!(normal.allFinite() && normal.norm() > 0.5)) normal = Eigen::Vector3d::UnitY();
+  normal.normalize();
+  double half_width = 0.0;
+  for (int i = begin; i < end; ++i) half_width = std::max(half_width, std::abs(normal.dot(point(i) - centre)));
+  slab.centre = centre;
+  slab.normal = normal;
+  slab.half_width_m = half_width;
+  slab.reach_m = (node.hi - centre).cwiseAbs().cwiseMax((node.lo - centre).cwiseAbs());
+  return end;
+}
 
 TriangleTree::TriangleTree(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b,
                            const std::vector<Eigen::Vector3d>& c)

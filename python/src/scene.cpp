@@ -143,7 +143,7 @@ void bind_scene(py::module_& m) {
       .def_property_readonly("tool_box_size_m", [](const SceneDescription& s) { return vec(s.tool.box_size_m); },
                              "(3,) box tool extents [m]: x width, y thickness (thin axis), z length")
       .def_property_readonly("soft_shape", [](const SceneDescription& s) { return std::string(soft_shape_name(s.soft_body)); },
-                             "'sphere', 'cylinder' or 'slab'")
+                             "'sphere', 'cylinder', 'slab' or 'mesh'")
       .def_property_readonly(
           "hunt_crossley",
           [](const SceneDescription& s) {

@@ -2,6 +2,8 @@
 // spatula mesh with rounded rims (paper Fig. 1 middle / Fig. 2).
 #include <fissure/host_sim/thin_tool.hpp>
 
+#include "fissure/host_sim/mesh_bvh.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -233,6 +235,64 @@ TEST(ToolNodesConvexMesh, RejectsNonConvexAndBrokenMeshes) {
   for (int i = 0; i < a.node_count(); ++i)
     EXPECT_TRUE(a.normals_tool()[static_cast<std::size_t>(i)].isApprox(b.normals_tool()[static_cast<std::size_t>(i)]));
   EXPECT_NEAR(a.signed_distance_m(Eigen::Vector3d::Zero()), -0.001, 1e-9);
+}
+
+// The box trees and the plane hash give what the scans they replaced gave: the same planes (each
+// triangle on the first plane within 1 − 1e-9 in cosine and tol in offset) and the same pairs
+// (nearest hit within the limit, the last of equal hits). The tilted copy puts the planes off
+// the axes, across the hash's cell boundaries.
+TEST(ToolNodesConvexMesh, PlanesAndPairsAreTheScansAnswers) {
+  RoundedSpatulaParams params;
+  params.corner_segments = 10;
+  params.face_divisions = 12;
+  const ConvexMeshToolShape flat = make_rounded_spatula_mesh(params, 3.0 * params.thickness_m);
+  ConvexMeshToolShape tilted = flat;
+  const Eigen::Quaterniond turn(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1.0, 2.0, 3.0).normalized()));
+  for (auto& v : tilted.vertices_tool_m) v = turn * v;
+  for (const ConvexMeshToolShape* shape : {&flat, static_cast<const ConvexMeshToolShape*>(&tilted)}) {
+    // The scans, as from_convex_mesh ran them before the trees.
+    const auto& verts = shape->vertices_tool_m;
+    Eigen::AlignedBox3d box;
+    for (const auto& p : verts) box.extend(p);
+    const double tol_m = 1e-6 * box.diagonal().norm();
+    std::vector<Eigen::Vector3d> n, a, b, c;
+    for (const auto& t : shape->triangles) {
+      a.push_back(verts[static_cast<std::size_t>(t[0])]);
+      b.push_back(verts[static_cast<std::size_t>(t[1])]);
+      c.push_back(verts[static_cast<std::size_t>(t[2])]);
+      n.push_back((b.back() - a.back()).cross(c.back() - a.back()).normalized());  // outward: the generator's winding
+    }
+    std::vector<ToolPlane> planes;
+    std::vector<int> plane_of;
+    for (std::size_t f = 0; f < n.size(); ++f) {
+      const double offset = n[f].dot(a[f]);
+      int index = -1;
+      for (std::size_t q = 0; q < planes.size() && index < 0; ++q)
+        if (planes[q].normal_tool.dot(n[f]) > 1.0 - 1e-9 && std::abs(planes[q].offset_m - offset) <= tol_m) index = static_cast<int>(q);
+      if (index < 0) {
+        index = static_cast<int>(planes.size());
+        planes.push_back(ToolPlane{n[f], offset});
+      }
+      plane_of.push_back(index);
+    }
+    const ToolNodes tool = ToolNodes::from_convex_mesh(*shape);
+    ASSERT_EQ(tool.planes().size(), planes.size());
+    EXPECT_EQ(tool.plane_of_node(), plane_of);
+    for (std::size_t i = 0; i < n.size(); ++i) {
+      const Eigen::Vector3d origin = (a[i] + b[i] + c[i]) / 3.0;
+      double best_t = shape->pairing_ray_limit_m;
+      int best = -1;
+      for (std::size_t j = 0; j < n.size(); ++j) {
+        if (j == i) continue;
+        const double t = ray_triangle(origin, -n[i], a[j], b[j], c[j]);
+        if (t > tol_m && t <= best_t) {
+          best_t = t;
+          best = static_cast<int>(j);
+        }
+      }
+      EXPECT_EQ(tool.pair_of()[i], best) << "node " << i << (shape == &tilted ? " (tilted)" : "");
+    }
+  }
 }
 
 }  // namespace

@@ -36,14 +36,20 @@ class BoxTree {
   const std::vector<Eigen::Vector3d>* hi_ = nullptr;
 };
 
-/// Vertices of a mesh, for "is any vertex beyond this plane?".
+/// Vertices of a mesh, for "is any vertex beyond this plane?". Each node also keeps the slab
+/// its points lie in — the plane of least spread through their centroid (the covariance's
+/// smallest eigenvector) and the largest distance from it: a box of points on a flat face that
+/// is tilted to the axes sticks out of that face's plane, the slab does not, so the queries of
+/// that face's own triangles stop at the top of the tree instead of visiting every vertex on
+/// the face.
 class VertexTree {
  public:
   explicit VertexTree(const std::vector<Eigen::Vector3d>& vertices);
   /// A vertex v (the first found in tree order) for which beyond(v) holds, or -1. The caller's
   /// `beyond` is the exact test (evaluated as written, so its verdict is unchanged); it must
-  /// imply n·v > bound_m up to rounding: a box is skipped only when its support in n is below
-  /// bound_m by more than a slack of 1e-9 of the coordinates' size (far above any rounding).
+  /// imply n·v > bound_m up to rounding (|n| = 1): a node is skipped only when an upper bound of
+  /// n·v over it (the smaller of its box's support and its slab's) is below bound_m by more than
+  /// a slack of 1e-9 of the coordinates' size (far above any rounding).
   template <class Beyond>
   [[nodiscard]] int find_beyond(const Eigen::Vector3d& n, double bound_m, Beyond&& beyond) const {
     const auto& nodes = tree_.nodes();
@@ -53,10 +59,9 @@ class VertexTree {
     int top = 0;
     stack[top++] = 0;
     while (top > 0) {
-      const BoxTree::Node& node = nodes[static_cast<std::size_t>(stack[--top])];
-      double support = 0.0;
-      for (int k = 0; k < 3; ++k) support += std::max(n[k] * node.lo[k], n[k] * node.hi[k]);
-      if (support <= threshold) continue;
+      const int index = stack[--top];
+      const BoxTree::Node& node = nodes[static_cast<std::size_t>(index)];
+      if (upper_bound(index, n) <= threshold) continue;
       if (node.count > 0) {
         for (int k = 0; k < node.count; ++k) {
           const int v = tree_.items()[static_cast<std::size_t>(node.first + k)];
@@ -71,8 +76,30 @@ class VertexTree {
   }
 
  private:
+  struct Slab {
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();  ///< centroid of the node's points
+    Eigen::Vector3d normal = Eigen::Vector3d::UnitY();  ///< unit normal of the plane of least spread
+    double half_width_m = 0.0;                          ///< max |normal·(v − centre)| over the points
+    Eigen::Vector3d reach_m = Eigen::Vector3d::Zero();  ///< max |v_k − centre_k| over the box, per axis
+  };
+  /// An upper bound of n·v over node `index`'s points: min(box support, slab bound), where for
+  /// n = α·normal + w (w ⊥ normal), n·v = n·centre + α·normal·(v − centre) + w·(v − centre)
+  /// ≤ n·centre + |α|·half_width + Σ_k |w_k|·reach_k.
+  [[nodiscard]] double upper_bound(int index, const Eigen::Vector3d& n) const {
+    const BoxTree::Node& node = tree_.nodes()[static_cast<std::size_t>(index)];
+    double box = 0.0;
+    for (int k = 0; k < 3; ++k) box += std::max(n[k] * node.lo[k], n[k] * node.hi[k]);
+    const Slab& slab = slabs_[static_cast<std::size_t>(index)];
+    const double alpha = n.dot(slab.normal);
+    const Eigen::Vector3d w = n - alpha * slab.normal;
+    const double flat = n.dot(slab.centre) + std::abs(alpha) * slab.half_width_m + w.cwiseAbs().dot(slab.reach_m);
+    return std::min(box, flat);
+  }
+  int fill_slabs(int index);  ///< computes the slabs below `index`; returns the end of its item range
+
   const std::vector<Eigen::Vector3d>& vertices_;
   BoxTree tree_;
+  std::vector<Slab> slabs_;
   double slack_m_ = 0.0;
 };
 
