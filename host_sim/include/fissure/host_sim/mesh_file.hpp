@@ -6,8 +6,9 @@
 // binary file's size is 84 + 50 bytes per triangle, whatever its header says).
 //
 // Errors name the file, the element and the reason: "'PATH' line 12: …" while parsing, and
-// "'PATH': triangle 7 (line 40): …" / "'PATH': vertex 3 (at x, y, z m): …" from the shape
-// checks (mesh_checks.hpp). Triangles and vertices are numbered from 1 in the order of the file.
+// "'PATH': triangle 7 (line 40): …" / "'PATH': vertex 3: …" from the shape
+// checks (mesh_checks.hpp). Triangles and vertices are numbered from 1 in the order of the file
+// (an STL's welded vertices in the order they first appear).
 #include <array>
 #include <cstddef>
 #include <cstdint>
