@@ -183,6 +183,7 @@ nlohmann::json tilted_row(const SpatulaSize& size) {
   for (auto& v : shape.vertices_tool_m) v = turn * v;
   std::printf("%-14s %-9s %9zu tris  ", (std::string("spatula-") + size.name).c_str(), "tilted", shape.triangles.size());
   std::fflush(stdout);
+  // The tool check's tolerance: 1e-5 of the spatula's ~65 mm diagonal (tool_mesh_io.cpp).
   const double check_s = seconds_of([&] { host::check_convex(shape.vertices_tool_m, shape.triangles, 1e-5 * 0.065); });
   const double nodes_s = seconds_of([&] { (void)host::ToolNodes::from_convex_mesh(shape); });
   std::printf("convexity check %8.3f s  nodes %8.3f s\n", check_s, nodes_s);
