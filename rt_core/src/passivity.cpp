@@ -35,14 +35,6 @@ double bounding_speed_m_per_s(double period_s) noexcept {
                   kPassivityBoundingMinCountsPerTick * kPassivityEncoderCount_m / period_s);
 }
 
-/// The share of F that pays the debt D over the return of the stored energy U (passivity.hpp):
-/// withheld in proportion to what has been returned since the hold, R = U_hold − U, i.e.
-/// g(u) = a·(U_hold − u)/U_hold for u from U down to 0 with a such that ∫₀^U g du = D, which
-/// gives g = 2·D·R / (U·(U + 2R)) — 0 at the hold, D/U as U → 0.
-double debt_schedule_fraction(double debt_j, double stored_j, double returned_j) noexcept {
-  return std::min(1.0, 2.0 * debt_j * returned_j / (stored_j * (stored_j + 2.0 * returned_j)));
-}
-
 }  // namespace
 
 void observe_energy(PassivityState& state, const Eigen::Vector3d& p_device_m) noexcept {
@@ -63,7 +55,7 @@ void observe_energy(PassivityState& state, const Eigen::Vector3d& p_device_m) no
 Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState& state,
                                   const Eigen::Vector3d& force_device_n, const Eigen::Vector3d& v_filtered_m_per_s,
                                   const Eigen::Vector3d& v_raw_m_per_s, double period_s,
-                                  double stored_energy_j, double host_stored_change_j) noexcept {
+                                  double stored_energy_j) noexcept {
   state.damping_n_s_per_m = 0.0;
   state.energy_bound_acted = false;
   if (state.recovery_window_left_s > 0.0) {
@@ -113,26 +105,7 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
   // and grows while the environment returns energy (below); once it is paid — by g, by β, or by
   // the device's own damper — g gives the force back, at a hold too: nothing is owed there
   // (what the full force then stores is owed, and withheld, on the way out).
-  // Host-made debt H (passivity.hpp): stored energy the host put into the contact by moving it
-  // (a proxy swap, a stall), still stored and still owed; collected over its return.
-  state.stored_last_j = stored_energy_j;
-  state.host_debt_j = std::clamp(state.host_debt_j + host_stored_change_j, 0.0,
-                                 std::max(0.0, std::min(debt_excess_j, stored_j)));
-  // The debt the loop made (a sampled wall's surplus, energy delivered): collected as before.
-  const double prompt_debt_j = debt_excess_j - state.host_debt_j;
-  double target = kept_debt_excess_j - state.host_debt_j > 0.0 ? state.reduction_fraction : 0.0;
-  if (state.host_debt_j > 0.0) {
-    // R: what the contact has returned, on a velocity slow enough to pass an unload but not the
-    // ~60 Hz rest buzz, leaking so that a rest re-anchors the schedule.
-    state.v_slow_m_per_s += std::min(1.0, period_s / kPassivityReturnFilter_s) * (v_filtered_m_per_s - state.v_slow_m_per_s);
-    state.debt_returned_j =
-        std::max(0.0, state.debt_returned_j * (1.0 - std::min(1.0, period_s / kPassivityReturnedLeak_s)) +
-                          force.dot(state.v_slow_m_per_s) * period_s);
-    target = std::max(target, debt_schedule_fraction(state.host_debt_j, stored_j, state.debt_returned_j));
-  } else {
-    state.debt_returned_j = 0.0;
-    state.v_slow_m_per_s = v_filtered_m_per_s;
-  }
+  double target = kept_debt_excess_j > 0.0 ? state.reduction_fraction : 0.0;
   double raise_step_n = config.max_correction_step_n;
 
   if (speed >= config.min_speed_m_per_s) {
@@ -157,10 +130,10 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
     const double returning_m_per_s = force_direction.dot(v_raw_m_per_s);  // F̂·v
     // Power the force returns by the filtered velocity (quantisation-free: ≈ 0 at a hold).
     const double returned_power_w = std::max(0.0, force_direction.dot(v_filtered_m_per_s)) * force_n;
-    if (prompt_debt_j > 0.0 && returning_m_per_s > 0.0 && force_n > 0.0) {
+    if (debt_excess_j > 0.0 && returning_m_per_s > 0.0 && force_n > 0.0) {
       // Withhold the debt from what the force returns over dissipation_time_s (a wall
       // giving back slightly more than it stored)…
-      const double share_for_excess = prompt_debt_j / (config.dissipation_time_s * returning_m_per_s * force_n);
+      const double share_for_excess = debt_excess_j / (config.dissipation_time_s * returning_m_per_s * force_n);
       // …unless the loop has already generated more than the ramp's energy budget: then
       // the environment is plainly active (a swap offset left from a contact the host has
       // lost, pushing the hand out at watts) and the push comes off entirely, ramped. Only
@@ -168,7 +141,7 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
       // excess grew: an overshoot of P·dissipation_time_s (0.2 J at 4 W: the
       // hc_lambda_over_k_0 stress case, 0.115 J).
       const double share = predicted_j > budget_j ? 1.0 : share_for_excess;
-      target = std::max({target, state.reduction_fraction, std::min(1.0, share)});
+      target = std::max(state.reduction_fraction, std::min(1.0, share));
     }
     // The fraction may grow by at most max_correction_step_n of force per tick, steeper in
     // proportion to how much energy has really been created (E' > 0).

@@ -161,27 +161,17 @@ TickResult tick(const RtModel& model, RtData& data, TickIo& io, const TickTiming
       stored_energy_j = fade_gain * data.safety.ramp_gain * model.device_energy_per_world_energy *
                         evaluation.stored_energy_world_j;
     }
-    // Stored energy the host (not the hand) put into the contact this tick: what a new proxy
-    // stores at this pose beyond the one it replaces, or what the contact stores now beyond
-    // what it stored before a stall the observer did not see (passivity.hpp: host-made debt).
-    double host_stored_change_j = 0.0;
     if (history_break) {
       // A proxy accepted in this tick is the one in use: the force it gives here is what the
       // blend walks to; the one it replaces is as stale as the rest (proxy_blend.hpp).
       continue_after_break(data.blend, new_force);
-      host_stored_change_j = stored_energy_j - data.passivity.stored_last_j;
     } else if (intake == ProxyIntake::kAccepted) {
       Eigen::Vector3d old_force = Eigen::Vector3d::Zero();  // the first proxy blends in from zero
-      double old_stored_j = 0.0;
       if (data.proxy.have_previous) {
-        const ContactEvaluation old_evaluation =
-            evaluate_proxy(previous_proxy(data.proxy), config.mapping, data.tool, data.part_forces, model.damping_cap);
+        evaluate_proxy(previous_proxy(data.proxy), config.mapping, data.tool, data.part_forces, model.damping_cap);
         old_force = part_forces_to_device(config.mapping, data.part_forces);
-        old_stored_j = fade_gain * data.safety.ramp_gain * model.device_energy_per_world_energy *
-                       old_evaluation.stored_energy_world_j;
       }
       begin_swap(data.blend, old_force, new_force);
-      host_stored_change_j = stored_energy_j - old_stored_j;
     }
     // While a device fault is latched the command is zero and safety brings the force back by
     // its fault ramp-in, which already keeps the return continuous. A swap offset carried
@@ -197,7 +187,7 @@ TickResult tick(const RtModel& model, RtData& data, TickIo& io, const TickTiming
     const Eigen::Vector3d environment_device_n =
         data.contact_force_device_n + workspace_soft_wall_n(config.safety, data.p_device_m, flags);
     force = passivity_control(config.passivity, data.passivity, environment_device_n, data.v_device_m_per_s,
-                              data.velocity.x1, model.period_s, stored_energy_j, host_stored_change_j);
+                              data.velocity.x1, model.period_s, stored_energy_j);
     if ((data.passivity.damping_n_s_per_m) > 0.0) flags |= kFlagPassivityActive;
   } else {
     data.contact_force_device_n.setZero();

@@ -162,13 +162,6 @@ inline constexpr double kPassivityMaxDampingCredit_j =
 /// 5.6 % of a 2 N force at 6 N·s/m (4.7 % at 5). Far below CHAI3D's 20 N·s/m Falcon limit (BRIEF §5).
 inline constexpr double kDefaultPassivityMaxDamping_n_s_per_m = 5.0;
 
-/// Host-made debt schedule (issue 26, third pass; docs/decisions.md): the velocity the returned
-/// energy R is integrated on is v_f low-passed with this time constant [s] (the ~60 Hz rest buzz
-/// passes at ~1/40, an unload over ≥ 0.1 s nearly whole)…
-inline constexpr double kPassivityReturnFilter_s = 0.1;
-/// …and R leaks with this time constant [s], so that a rest re-anchors the schedule.
-inline constexpr double kPassivityReturnedLeak_s = 0.03;
-
 struct PassivityConfig {
   bool enabled = true;
   /// The device's own viscous damping b [N·s/m] (kFalconDeviceDamping_n_s_per_m, safety.hpp).
@@ -217,13 +210,6 @@ struct PassivityState {
   /// device's dissipation g counts against the debt [J]
   double damping_credit_j = 0.0;
   double reduction_fraction = 0.0;        ///< g: share of F taken off along F̂ [0, 1]
-  /// R: what the environment has returned since the debt's schedule began, Σ F·Δp ≥ 0 [J]
-  double debt_returned_j = 0.0;
-  /// H: the part of the debt the host made by moving the contact (host_stored_change_j), still
-  /// stored: collected over the return, not at the hold [J]
-  double host_debt_j = 0.0;
-  double stored_last_j = 0.0;
-  Eigen::Vector3d v_slow_m_per_s = Eigen::Vector3d::Zero();  ///< U of the last tick (as passed in) [J]
   double reduction_n = 0.0;               ///< r = g·|F| in the last tick [N]
   double added_damping_n_s_per_m = 0.0;   ///< β
   /// Telemetry: the correction expressed as a damping, |F − F_out| / max(|v_f|, min_speed)
@@ -245,7 +231,7 @@ void observe_energy(PassivityState& state, const Eigen::Vector3d& p_device_m) no
 Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState& state,
                                   const Eigen::Vector3d& force_device_n, const Eigen::Vector3d& v_filtered_m_per_s,
                                   const Eigen::Vector3d& v_raw_m_per_s, double period_s,
-                                  double stored_energy_j = 0.0, double host_stored_change_j = 0.0) noexcept;
+                                  double stored_energy_j = 0.0) noexcept;
 
 /// Records the force that actually went out this tick (after safety) for the observer.
 void record_sent_force(PassivityState& state, const Eigen::Vector3d& force_device_n) noexcept;
