@@ -14,6 +14,7 @@
 #include <Eigen/Geometry>
 
 #include "fissure/eval/eval_error.hpp"
+#include "fissure/eval/stall_force_check.hpp"
 #include "fissure/falcon_hw/sim_falcon.hpp"
 #include "fissure/host_sim/scene_loader.hpp"
 #include "fissure/host_sim/soft_body_builder.hpp"
@@ -535,8 +536,8 @@ struct HostExchanges {
 /// Checks each telemetry sample and host status; keeps the first message per failed assertion.
 class Checker {
  public:
-  Checker(StressRow& row, const StressSetup& setup, double period_s)
-      : row_(row), setup_(setup), period_s_(period_s) {}
+  Checker(StressRow& row, const StressSetup& setup, double period_s, const rt::SafetyConfig& safety)
+      : stall_check_(setup.rt_stalls, period_s, safety), row_(row), setup_(setup), period_s_(period_s) {}
 
   void fail(const std::string& what, double t_s) {
     if (failed_kinds_.size() > 16) return;
@@ -602,10 +603,12 @@ class Checker {
 
   void finish(double end_s) {
     if (!setup_.rt_stalls.empty()) {
-      char what[200];
-      std::snprintf(what, sizeof what, "after %zu rt stalls: |F_cmd - F_contact|/|F_contact| max %.4f over %llu checked ticks",
+      char what[240];
+      std::snprintf(what, sizeof what,
+                    "after %zu rt stalls: |F_cmd - F_env|/|F_env| (F_env = contact + soft wall) max %.4f over %llu checked "
+                    "ticks, %zu stalls over tolerance",
                     setup_.rt_stalls.size(), row_.stall_force_error_max,
-                    static_cast<unsigned long long>(row_.stall_checked_ticks));
+                    static_cast<unsigned long long>(row_.stall_checked_ticks), stall_check_.stalls_failed());
       row_.note += (row_.note.empty() ? "" : "; ") + std::string(what);
       if (row_.stall_checked_ticks == 0) fail("rt stall: no tick in contact was checked after a stall", end_s);
     }
@@ -649,50 +652,18 @@ class Checker {
     (void)period_s_;
   }
 
-  // From kStressStallRecovery_s after a stall, for kStressStallCheck_s: the commanded force
-  // within kStressStallForceTolerance of the contact force (where that is ≥ kStressStallMinForce_n),
-  // both as their means over the last kStressStallMeanWindow_s (stress_cases.hpp says why).
+  // After each stall: the commanded force against what the loop renders as the environment
+  // (contact + workspace soft wall; stall_force_check.hpp says why both).
   void check_after_stall(const rt::TelemetrySample& s, double t_s) {
-    while (next_stall_ < setup_.rt_stalls.size() &&
-           t_s >= setup_.rt_stalls[next_stall_].end_s + kStressStallRecovery_s + kStressStallCheck_s) {
-      ++next_stall_;
-    }
-    if (next_stall_ >= setup_.rt_stalls.size()) return;
-    const double window_start_s = setup_.rt_stalls[next_stall_].end_s + kStressStallRecovery_s;
-    if (t_s < window_start_s - kStressStallMeanWindow_s) {
-      mean_samples_ = 0;
-      return;
-    }
-    const auto window_ticks = static_cast<std::size_t>(std::lround(kStressStallMeanWindow_s / period_s_));
-    const std::size_t slot = mean_samples_++ % kMeanRingSize;
-    commanded_ring_[slot] = as_eigen(s.force_device_n);
-    contact_ring_[slot] = as_eigen(s.contact_force_device_n);
-    if (t_s < window_start_s || mean_samples_ < window_ticks) return;
-    Eigen::Vector3d commanded = Eigen::Vector3d::Zero(), contact = Eigen::Vector3d::Zero();
-    for (std::size_t k = 0; k < window_ticks; ++k) {
-      const std::size_t i = (mean_samples_ - 1 - k) % kMeanRingSize;
-      commanded += commanded_ring_[i];
-      contact += contact_ring_[i];
-    }
-    commanded /= static_cast<double>(window_ticks);
-    contact /= static_cast<double>(window_ticks);
-    const double contact_n = contact.norm();
-    if (!(contact_n >= kStressStallMinForce_n)) return;
-    const double error = (commanded - contact).norm() / contact_n;
-    ++row_.stall_checked_ticks;
-    row_.stall_force_error_max = std::max(row_.stall_force_error_max, error);
-    if (error > kStressStallForceTolerance) {
-      fail("rt stall: commanded force not within 5 % of the contact force 200 ms after the stall", t_s);
+    const StallCheckTick checked = stall_check_.tick(s);
+    row_.stall_checked_ticks = stall_check_.checked_ticks();
+    row_.stall_force_error_max = stall_check_.error_max();
+    if (checked.outcome == StallCheckOutcome::kOverTolerance) {
+      fail("rt stall: commanded force not within 5 % of the contact + soft-wall force 200 ms after the stall", t_s);
     }
   }
 
-  /// Ring of the last commanded and contact forces for check_after_stall's means (≥ the window's
-  /// ticks at the fastest rate, 10 kHz × kStressStallMeanWindow_s).
-  static constexpr std::size_t kMeanRingSize = 256;
-  std::array<Eigen::Vector3d, kMeanRingSize> commanded_ring_{};
-  std::array<Eigen::Vector3d, kMeanRingSize> contact_ring_{};
-  std::size_t mean_samples_ = 0;
-
+  StallForceCheck stall_check_;
   StressRow& row_;
   const StressSetup& setup_;
   double period_s_;
@@ -758,7 +729,7 @@ void run_setup(StressSetup& setup, StressRow& row) {
     host_bridge = std::make_unique<LinkBridge>(*host_carrier, clock, host_link, kRtSilentAfter_ns);
   }
 
-  Checker checker(row, setup, model.period_s);
+  Checker checker(row, setup, model.period_s, model.config.safety);
   const auto end_ns = static_cast<TimeNs>(std::llround(setup.duration_s * 1e9));
   rt::TelemetrySample sample;
   DeviceState state{};
