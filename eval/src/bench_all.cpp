@@ -80,6 +80,8 @@ std::vector<Child> children(const fs::path& out_dir) {
       {"rt", {"bench", "rt"}, {"--rt-policy", "best_effort"}, {"--rt-policy", "best_effort", "--seconds", "3"}, 75, 20},
       {"collision", {"bench", "collision"}, {}, {"--quick"}, 150, 30},
       {"proxy", {"bench", "proxy"}, {}, {"--host-rates", "1000", "100"}, 5, 3},
+      // Mesh import load times (issue 24): up to 362k-triangle tools; --quick stops at 41k.
+      {"mesh", {"bench", "mesh"}, {}, {"--quick"}, 60, 2},
       {"pareto", {"bench", "pareto"}, {}, {"--quick", "--repeats", "1"}, 12, 4},
       {"view", {"bench", "view"}, {"--out", view_runs}, {"--repeats", "1", "--out", view_runs}, 25, 9},
       // The ci profile in both modes (the report carries its summary): 80-260 s on the loaded VM.

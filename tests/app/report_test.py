@@ -39,6 +39,7 @@ REQUIRED_SECTIONS = [
     "## rt_core: tick time, wake-up latency against cyclictest",
     "## Z-width against tick rate",
     "## Stress summary",
+    "## Mesh import",
 ]
 
 failures = []
@@ -119,6 +120,8 @@ def main():
             "no stress case fails (other than known failures)": "**MISSED**",    # one FAIL case
             "ci profile runs in under 5 minutes": "met",
             "full profile passes (every case, ≥ 1e6 rt ticks each)": "not checked",  # no stress_full.json
+            # 41 160 → 361 600 triangles, 0.34 → 3.26 s: exponent 1.04
+            "convex tool mesh load time grows at most as n log n (exponent ≤ 1.1 between the two largest meshes)": "met",
         }
         for description, status in expectations.items():
             row = target_row(report, description)

@@ -4,7 +4,7 @@
 usage: make_report.py DIR [--md FILE] [--images DIR]
 
 DIR holds what `fissure bench all --out DIR` wrote: kinematics.json, rt.json, collision.json,
-proxy.json, pareto.json, view.json, stress.json and bench_all.json (which children ran, their
+proxy.json, pareto.json, view.json, stress.json, mesh.json and bench_all.json (which children ran, their
 exit codes and wall times). --md (default DIR/report.md) is the report; --images (default DIR)
 receives the PNGs, linked from the report by relative paths, so a report written to
 docs/benchmarks.md with --images docs/images/bench works from docs/.
@@ -30,7 +30,7 @@ from targets import MET, MISSED, NOT_CHECKED, Target, evaluate_all  # noqa: E402
 
 REGENERATE = "build/bin/fissure bench all --out out/bench --docs docs --stress-full"
 
-BENCHMARKS = ["kinematics", "rt", "collision", "proxy", "pareto", "view", "stress", "stress_full"]
+BENCHMARKS = ["kinematics", "rt", "collision", "proxy", "pareto", "view", "stress", "stress_full", "mesh"]
 # `fissure render` children of bench all: one PNG frame each of the 10 m/s plunge.
 PLUNGE_FRAMES = {"plunge_bullet": "plunge-bullet", "plunge_paired": "plunge-paired"}
 
@@ -769,7 +769,32 @@ def section_view(report, data, problems, targets):
     report.add(targets_table([t for t in targets if t.section == "view"]))
 
 
-SECTIONS = [section_pareto, section_tunnelling, section_scaling, section_rt, section_stress, section_view]
+def section_mesh(report, data, problems, targets):
+    report.add("## Mesh import — `fissure bench mesh`")
+    report.add("")
+    mesh = data.get("mesh")
+    if not mesh:
+        missing(report, "mesh", problems)
+        return
+    report.add("Load time of a convex tool mesh (read, the closed / manifold / outward / convex checks, the thin-tool "
+               "nodes and pairs) and of a soft-body surface mesh, against the number of triangles"
+               + (" (a --quick run: no 362k-triangle rows)." if mesh.get("quick") else "."))
+    report.add("")
+    report.add(table(["tool mesh", "format", "triangles", "read s", "check s", "nodes s", "load s"],
+                     [[r.get("mesh"), r.get("format"), r.get("triangles"), fmt(r.get("read_s")), fmt(r.get("check_s")),
+                       fmt(r.get("nodes_s")), fmt(r.get("load_s"))] for r in mesh.get("tool_meshes", [])]
+                     + [[r.get("mesh"), r.get("format"), r.get("triangles"), fmt(r.get("read_s")), "—", "—", "—"]
+                        for r in mesh.get("tool_meshes_stl", [])]
+                     + [[r.get("mesh"), "tilted", r.get("triangles"), "—", fmt(r.get("check_s")), fmt(r.get("nodes_s")), "—"]
+                        for r in mesh.get("tool_meshes_tilted", [])]))
+    report.add("")
+    report.add(table(["soft mesh", "format", "triangles", "read s", "build s"],
+                     [[r.get("mesh"), r.get("format"), r.get("triangles"), fmt(r.get("read_s")), fmt(r.get("build_s"))]
+                      for r in mesh.get("soft_meshes", [])]))
+    report.add(targets_table([t for t in targets if t.section == "mesh"]))
+
+
+SECTIONS = [section_pareto, section_tunnelling, section_scaling, section_rt, section_stress, section_view, section_mesh]
 
 
 def main():

@@ -398,11 +398,34 @@ def stress_full_targets(stress):
     return [Target("stress_full", descriptions[0], measured, _status(bool(cases) and not failed and not short), STRESS_SOURCE)]
 
 
+# ---------------------------------------------------------------- mesh import (issue 24)
+
+MESH_SOURCE = "issue 24"
+
+
+def mesh_targets(mesh):
+    """Loading linear in mesh size: the growth exponent of the convex tool's load time between its
+    two largest rows, log(t2/t1) / log(n2/n1). n log n between 41k and 362k triangles is 1.09;
+    the quadratic loader of before was 2. A --quick run has no 362k row and cannot decide it."""
+    d = ["convex tool mesh load time grows at most as n log n (exponent ≤ 1.1 between the two largest meshes)"]
+    if mesh is None:
+        return _absent("mesh", d, MESH_SOURCE, "no mesh.json")
+    rows = sorted((r for r in mesh.get("tool_meshes", []) if r.get("load_s")), key=lambda r: r["triangles"])
+    if len(rows) < 2 or rows[-1]["triangles"] < 300000:
+        return _absent("mesh", d, MESH_SOURCE, "no row of ≥ 300k triangles (a --quick run)")
+    import math
+    a, b = rows[-2], rows[-1]
+    exponent = math.log(b["load_s"] / a["load_s"]) / math.log(b["triangles"] / a["triangles"])
+    text = (f"{exponent:.2f} ({a['triangles']} → {b['triangles']} triangles: "
+            f"{_f(a['load_s'])} → {_f(b['load_s'])} s)")
+    return [Target("mesh", d[0], text, _status(exponent <= 1.1), MESH_SOURCE)]
+
+
 def evaluate_all(data):
     checks = [("proxy", proxy_targets, "proxy"), ("pareto", pareto_targets, "pareto"),
               ("kinematics", kinematics_targets, "kinematics"), ("collision", collision_targets, "collision"), ("contact", contact_targets, "collision"),
               ("rt", rt_targets, "rt"), ("zwidth", zwidth_targets, "rt"), ("stress", stress_targets, "stress"),
-              ("stress_full", stress_full_targets, "stress_full")]
+              ("stress_full", stress_full_targets, "stress_full"), ("mesh", mesh_targets, "mesh")]
     out = []
     for section, function, name in checks:
         try:
