@@ -7,6 +7,15 @@
 
 namespace fissure::host {
 
+void CellStepCounts::take(const HostStepResult& step, int cut_triangles) {
+  crossed_nodes = std::max(crossed_nodes, step.crossing.crossed_nodes);
+  inside_nodes = std::max(inside_nodes, step.crossing.inside_nodes);
+  max_penetration_m = std::max(max_penetration_m, step.crossing.max_penetration_m);
+  max_cut_triangles = std::max(max_cut_triangles, cut_triangles);
+  if (cut_triangles > 0) ++steps_with_cut_triangles;
+  step_s.push_back(step.times.total_s);
+}
+
 LeverResult run_lever_hold(const SceneDescription& scene, SceneCollisionMethod method, double hold_s) {
   const PlungeTool& blade = plunge_tools()[2];
   HostSimulation sim(scene, method);
@@ -16,13 +25,7 @@ LeverResult run_lever_hold(const SceneDescription& scene, SceneCollisionMethod m
   const double end_y = start.end_y_m;
   LeverResult result;
   auto record = [&](const HostStepResult& r) {
-    result.crossed_nodes = std::max(result.crossed_nodes, r.crossing.crossed_nodes);
-    result.inside_nodes = std::max(result.inside_nodes, r.crossing.inside_nodes);
-    result.max_penetration_m = std::max(result.max_penetration_m, r.crossing.max_penetration_m);
-    const int cut = sim.triangles_cut_by_tool(kInsideToleranceM);
-    result.max_cut_triangles = std::max(result.max_cut_triangles, cut);
-    if (cut > 0) ++result.steps_with_cut_triangles;
-    result.step_s.push_back(r.times.total_s);
+    result.take(r, sim.triangles_cut_by_tool(kInsideToleranceM));
     ++result.steps;
   };
   while (pose.position_world_m.y() > end_y) {
@@ -65,12 +68,7 @@ ClampReleaseResult run_clamp_release(const SceneDescription& clamp_scene, SceneC
     result.script_max_force_n = std::max(result.script_max_force_n, f);
     if (r.jaw_gap_m >= open_m - 1e-9 && ++result.open_steps > kClampOpenGraceSteps)
       result.open_force_max_n = std::max(result.open_force_max_n, f);
-    result.crossed_nodes = std::max(result.crossed_nodes, r.crossing.crossed_nodes);
-    result.max_penetration_m = std::max(result.max_penetration_m, r.crossing.max_penetration_m);
-    const int cut = sim.triangles_cut_by_tool(kInsideToleranceM);
-    result.max_cut_triangles = std::max(result.max_cut_triangles, cut);
-    if (cut > 0) ++result.steps_with_cut_triangles;
-    result.step_s.push_back(r.times.total_s);
+    result.take(r, sim.triangles_cut_by_tool(kInsideToleranceM));
   }
   return result;
 }

@@ -10,6 +10,8 @@
 
 namespace fissure::host {
 
+struct HostStepResult;
+
 /// Levering: the 1 mm blade (plunge_tools()[2]) inserted edge-first kPlungeDepth_m into the ball
 /// at this speed [m/s] (quasi-static: the cell is about the turn, not the impact) ...
 inline constexpr double kLeverInsertSpeed_m_s = 0.1;
@@ -20,15 +22,22 @@ inline constexpr double kLeverAngle_rad = 0.5235987755982988;
 /// ... at this rate [rad/s] (issue 22: 1 rad/s), then held kHoldSettle_s + the hold.
 inline constexpr double kLeverRate_rad_s = 1.0;
 
-struct LeverResult {
+/// What both cells count on every step they run: the paired guarantees and the step's wall time.
+struct CellStepCounts {
   int crossed_nodes = 0, inside_nodes = 0;  ///< worst step, whole cell
   double max_penetration_m = 0.0;           ///< whole cell
-  int max_cut_triangles = 0;                ///< triangles_cut_by_tool(kInsideToleranceM): most on a step (insert, turn and hold)
+  int max_cut_triangles = 0;                ///< triangles_cut_by_tool(kInsideToleranceM): most on a step
   int steps_with_cut_triangles = 0;         ///< steps with at least one
-  int steps = 0;                            ///< steps of the cell
+  std::vector<double> step_s;               ///< wall time of every step
+
+  /// Takes in one step's result and the triangles the tool cuts after it.
+  void take(const HostStepResult& step, int cut_triangles);
+};
+
+struct LeverResult : CellStepCounts {
+  int steps = 0;                            ///< steps of the cell (insert, turn and hold)
   std::vector<double> hold_force_n;         ///< |F| per step of the measured hold
   HoldForceStats hold;
-  std::vector<double> step_s;               ///< wall time of every step
 };
 
 /// Settles `scene` (a plunge_scene of the blade), inserts, turns and holds `hold_s`.
@@ -39,16 +48,11 @@ struct LeverResult {
 /// which the jaws are fully open (issue 22: 0 N within 5 ms at 1 kHz).
 inline constexpr int kClampOpenGraceSteps = 5;
 
-struct ClampReleaseResult {
+struct ClampReleaseResult : CellStepCounts {
   double settle_s = 0.0;
   double script_max_force_n = 0.0;  ///< the larger jaw's |F|, most over the script (did it grab?)
   int open_steps = 0;               ///< steps with the jaws fully open
   double open_force_max_n = 0.0;   ///< the larger jaw's |F|, most after the grace steps
-  int crossed_nodes = 0;            ///< worst step
-  double max_penetration_m = 0.0;
-  int max_cut_triangles = 0;        ///< most on a step over the script
-  int steps_with_cut_triangles = 0;
-  std::vector<double> step_s;
 };
 
 [[nodiscard]] ClampReleaseResult run_clamp_release(const SceneDescription& clamp_scene, SceneCollisionMethod method, double settle_s);
