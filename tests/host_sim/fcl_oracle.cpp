@@ -18,7 +18,10 @@ namespace fissure::host::test_oracle {
 
 namespace {
 
-using Bvh = fcl::BVHModel<fcl::AABBd>;  // AABB: the cheapest to build, and the mesh is rebuilt for every pose
+// OBBRSS: fcl collides it against a shape in the mesh's own frame; for AABB it copies the model to
+// transform it, and that copy is allocated inside libfcl and freed by this build's Eigen operator
+// delete[] (an allocator mismatch ASan reports).
+using Bvh = fcl::BVHModel<fcl::OBBRSSd>;
 
 // A convex hull computed by Bullet (float inside); its vertices mapped back to the nearest of the
 // double-precision input points, its faces as loops of those input indices.
