@@ -15,6 +15,7 @@ namespace fissure::app {
 void register_bench_collision(CommandTree& tree) {
   struct Arguments {
     std::string json_path;
+    std::string contact_response = "after_step";
     eval::BenchCollisionOptions bench;
   };
   auto a = std::make_shared<Arguments>();
@@ -24,7 +25,12 @@ void register_bench_collision(CommandTree& tree) {
   cmd->add_flag("--full", a->bench.full, "More timing samples per cost-vs-mesh row (300 instead of 100); same cells");
   cmd->add_option("--only", a->bench.only, "Run only these parts (default: all; the report needs all)")
       ->check(CLI::IsMember({"sweep", "cells", "indentation", "scaling"}));
+  cmd->add_option("--contact-response", a->contact_response,
+                  "Where the paired / ray response acts in every scene: after_step (after Bullet's step) or in_solver (inside its position iterations)")
+      ->check(CLI::IsMember({host::to_string(host::ContactResponse::kAfterStep), host::to_string(host::ContactResponse::kInSolver)}))
+      ->capture_default_str();
   cmd->callback([a] {
+    a->bench.contact_response = *host::parse_contact_response(a->contact_response);  // IsMember checked the name
     write_json_file(a->json_path, eval::run_bench_collision(a->bench));
     std::printf("\nwrote %s\n", a->json_path.c_str());
   });

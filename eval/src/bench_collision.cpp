@@ -65,6 +65,12 @@ double load_average() {
 
 SceneDescription base_scene() { return host::load_scene(host::resolve_scene_path("spatula-sphere")); }
 
+// `scene` with the bench's contact response (BenchCollisionOptions::contact_response).
+SceneDescription with_response(SceneDescription scene, host::ContactResponse response) {
+  scene.simulation.contact_response = response;
+  return scene;
+}
+
 // Least-squares slope of log F against log d (points with F > 0).
 double fitted_exponent(const std::vector<std::pair<double, double>>& curve) {
   double sx = 0, sy = 0, sxx = 0, sxy = 0;
@@ -112,8 +118,8 @@ std::vector<std::pair<double, double>> indentation_curve(const SceneDescription&
   return curve;
 }
 
-SceneDescription sphere_scene(int faces, bool icosphere) {
-  SceneDescription s = base_scene();
+SceneDescription sphere_scene(int faces, bool icosphere, host::ContactResponse response) {
+  SceneDescription s = with_response(base_scene(), response);
   host::SoftSphere sphere = std::get<host::SoftSphere>(s.soft_body.shape);
   sphere.faces_count = faces;
   sphere.tessellation = icosphere ? host::SphereTessellation::kIcosphere : host::SphereTessellation::kBulletEllipsoid;
@@ -145,13 +151,13 @@ void print_sweep_legend(double hold_s) {
 
 // One sweep table: every tool × method × speed on the ball of `icosphere_faces` (0: the paper's 128-face shell).
 nlohmann::json sweep_cells(const std::vector<double>& speeds, const std::vector<SceneCollisionMethod>& methods, int icosphere_faces, double hold_s,
-                           const char* progress_name) {
+                           host::ContactResponse response, const char* progress_name) {
   const auto& tools = host::plunge_tools();
   nlohmann::json sweep = nlohmann::json::array();
   SimProgress progress(progress_name, static_cast<long>(speeds.size() * tools.size() * methods.size()));
   long done = 0;
   for (const host::PlungeTool& tool : tools) {
-    const SceneDescription scene = host::plunge_scene(tool, icosphere_faces);
+    const SceneDescription scene = with_response(host::plunge_scene(tool, icosphere_faces), response);
     const std::string tool_name(tool.name);
     for (SceneCollisionMethod method : methods) {
       for (double v : speeds) {
@@ -194,12 +200,13 @@ void run_sweep(const BenchCollisionOptions& o, nlohmann::json& out) {
                        {"hold_settle_s", host::kHoldSettle_s}};
   print_sweep_legend(hold_s);
   out["sweep"] = sweep_cells(speeds, {SceneCollisionMethod::kBullet, SceneCollisionMethod::kRay, SceneCollisionMethod::kPaired}, 0, hold_s,
-                             "bench collision: sweep");
+                             o.contact_response, "bench collision: sweep");
   std::printf("\n1b. The same paired cells on a %d-face icosphere (issue 22's second mesh)\n", kFineSweepFaces);
   out["sweep_fine_body"] = {{"faces", kFineSweepFaces}, {"tessellation", "icosphere"}, {"shape_matching_ratio", kShapeMatchingRatio},
                             {"plunge_depth_m", host::kPlungeDepth_m}, {"hold_s", hold_s}, {"hold_settle_s", host::kHoldSettle_s}};
   print_sweep_legend(hold_s);
-  out["sweep_fine"] = sweep_cells(speeds, {SceneCollisionMethod::kPaired}, kFineSweepFaces, hold_s, "bench collision: sweep, 1280 faces");
+  out["sweep_fine"] =
+      sweep_cells(speeds, {SceneCollisionMethod::kPaired}, kFineSweepFaces, hold_s, o.contact_response, "bench collision: sweep, 1280 faces");
 }
 
 // ---- 1c. Levering and clamp-release cells (issue 22) -------------------------------------------
@@ -212,7 +219,7 @@ void run_motion_cells(const BenchCollisionOptions& o, nlohmann::json& out) {
               "F_hold N", "jitter%", "step%");
   nlohmann::json lever = nlohmann::json::array();
   for (const int faces : {0, kFineSweepFaces}) {
-    const SceneDescription scene = host::plunge_scene(host::plunge_tools()[2], faces);
+    const SceneDescription scene = with_response(host::plunge_scene(host::plunge_tools()[2], faces), o.contact_response);
     for (SceneCollisionMethod method : {SceneCollisionMethod::kBullet, SceneCollisionMethod::kPaired}) {
       const host::LeverResult r = host::run_lever_hold(scene, method, hold_s);
       const int mesh = faces == 0 ? 128 : faces;
@@ -229,7 +236,7 @@ void run_motion_cells(const BenchCollisionOptions& o, nlohmann::json& out) {
   }
   out["lever"] = lever;
 
-  const SceneDescription clamp = host::load_scene(host::resolve_scene_path("clamp-sphere"));
+  const SceneDescription clamp = with_response(host::load_scene(host::resolve_scene_path("clamp-sphere")), o.contact_response);
   std::printf("\n1d. Clamp release: clamp-sphere's script (close, hold, open fully) after settling; the larger jaw's |F| from the %dth fully open step\n",
               host::kClampOpenGraceSteps + 1);
   std::printf("%-8s %-7s | %9s %9s %9s | %7s %9s %9s\n", "settle s", "method", "F_max N", "open N", "open stp", "crossed", "cut max", "cut stp");
@@ -270,7 +277,7 @@ double run_indentation(const SceneDescription& base, const std::vector<int>& mes
   const std::vector<double> depths = {0.0005, 0.001, 0.0015, 0.002, 0.003, 0.004};
   const auto slab_curve = indentation_curve(slab, depths, indent_hold_s);
   const double slab_n = fitted_exponent(slab_curve);
-  const SceneDescription sphere = sphere_scene(mesh_faces.back(), true);
+  const SceneDescription sphere = sphere_scene(mesh_faces.back(), true, base.simulation.contact_response);
   const std::vector<double> sphere_depths = {0.001, 0.002, 0.003, kConvergenceDepthM, 0.005, 0.006};
   const auto sphere_curve = indentation_curve(sphere, sphere_depths, indent_hold_s);
   finest_force_at_depth_n = sphere_curve[3].second;
@@ -291,12 +298,13 @@ double run_indentation(const SceneDescription& base, const std::vector<int>& mes
 }
 
 // ---- 3. Mesh convergence: the sphere's force at a fixed depth per mesh size. ------------------
-void run_convergence(const std::vector<int>& mesh_faces, double indent_hold_s, double finest_force_at_depth_n, nlohmann::json& out) {
+void run_convergence(const std::vector<int>& mesh_faces, double indent_hold_s, double finest_force_at_depth_n, host::ContactResponse response,
+                     nlohmann::json& out) {
   std::printf("\n3. Mesh convergence: sphere force at %.0f mm (paired)\n%8s %12s\n", kConvergenceDepthM * 1e3, "faces", "F N");
   nlohmann::json rows = nlohmann::json::array();
   for (int faces : mesh_faces) {
     const bool finest = faces == mesh_faces.back();
-    const double force = finest ? finest_force_at_depth_n : indentation_curve(sphere_scene(faces, true), {kConvergenceDepthM}, indent_hold_s)[0].second;
+    const double force = finest ? finest_force_at_depth_n : indentation_curve(sphere_scene(faces, true, response), {kConvergenceDepthM}, indent_hold_s)[0].second;
     std::printf("%8d %12.5f%s\n", faces, force, finest ? "  (from the indentation curve)" : "");
     rows.push_back({{"faces", faces}, {"depth_m", kConvergenceDepthM}, {"force_at_depth_n", force},
                     {"from_indentation_curve", finest}});
@@ -433,7 +441,7 @@ nlohmann::json scaling_summary(const nlohmann::json& rows, const std::vector<int
 // by Bullet's stock one (the same simulation, bit for bit), steps interleaved and the order
 // alternated so that neither always runs on the other's cache.
 nlohmann::json solver_bounds_ab(const std::vector<int>& mesh_faces, long samples) {
-  const SceneDescription scene = sphere_scene(mesh_faces.back(), true);
+  const SceneDescription scene = sphere_scene(mesh_faces.back(), true, host::ContactResponse::kAfterStep);
   HostSimulation fused(scene, SceneCollisionMethod::kPaired, host::HostSimulationOptions{true});
   HostSimulation stock(scene, SceneCollisionMethod::kPaired, host::HostSimulationOptions{false});
   host::ToolPose pose = host::to_tool_pose(scene.trajectory.start);
@@ -474,10 +482,10 @@ void run_scaling(const BenchCollisionOptions& o, const std::vector<int>& mesh_fa
               "per tri", "broad", "narrow", "resp", "force");
   nlohmann::json rows = nlohmann::json::array();
   std::vector<std::pair<SceneCollisionMethod, SceneDescription>> cases;
-  SceneDescription paper = sphere_scene(128, false);
+  SceneDescription paper = sphere_scene(128, false, o.contact_response);
   cases.emplace_back(SceneCollisionMethod::kBullet, paper);
   cases.emplace_back(SceneCollisionMethod::kPaired, paper);
-  for (int faces : mesh_faces) cases.emplace_back(SceneCollisionMethod::kPaired, sphere_scene(faces, true));
+  for (int faces : mesh_faces) cases.emplace_back(SceneCollisionMethod::kPaired, sphere_scene(faces, true, o.contact_response));
   for (const auto& [method, scene] : cases) measure_scaling_case(method, scene, samples, rows);
   out["scaling"] = rows;
   const nlohmann::json summary = scaling_summary(rows, mesh_faces);
@@ -496,7 +504,8 @@ nlohmann::json run_parts(const BenchCollisionOptions& o) {
   out["full"] = o.full;
   // The step times are wall clock on a shared VM: the load says how loaded it was.
   out["load_average_start"] = load_average();
-  const SceneDescription base = base_scene();
+  out["contact_response"] = host::to_string(o.contact_response);
+  const SceneDescription base = with_response(base_scene(), o.contact_response);
   if (o.runs("sweep")) {
     run_sweep(o, out);
     out["sweep_seconds"] = seconds_since(bench_start);
@@ -511,7 +520,7 @@ nlohmann::json run_parts(const BenchCollisionOptions& o) {
     const Clock::time_point indentation_start = Clock::now();
     const double indent_hold_s = o.quick ? 0.03 : 0.08;
     const double finest_force_at_depth_n = run_indentation(base, mesh_faces, indent_hold_s, out);
-    run_convergence(mesh_faces, indent_hold_s, finest_force_at_depth_n, out);
+    run_convergence(mesh_faces, indent_hold_s, finest_force_at_depth_n, o.contact_response, out);
     out["indentation_convergence_seconds"] = seconds_since(indentation_start);
   }
   if (o.runs("scaling")) {

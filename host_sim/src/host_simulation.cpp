@@ -79,12 +79,23 @@ HostSimulation::HostSimulation(const SceneDescription& scene, std::optional<Scen
   if (!bullet) {
     ThinBodyCollisionParams params;
     params.hunt_crossley = scene_.hunt_crossley;
+    params.response = scene_.simulation.contact_response;
     for (int p = 0; p < parts; ++p) {
       params.jaw = p;
       const ToolNodes& nodes = tool_nodes_[static_cast<std::size_t>(p)];
       SoftNodeBounds* bounds = world_->node_bounds();
       collisions_[static_cast<std::size_t>(p)] = method_ == SceneCollisionMethod::kPaired ? make_paired_collision(nodes, soft, params, bounds)
                                                                                           : make_ray_collision(nodes, soft, params, bounds);
+    }
+    if (params.response == ContactResponse::kInSolver) {
+      // The contact is solved in the NodeBoundsSolver's own copy of Bullet's position block, which
+      // it runs only for a body it can reproduce (node_bounds_solver.cpp).
+      NodeBoundsSolver* solver = world_->node_bounds_solver();
+      if (solver == nullptr)
+        throw std::invalid_argument("contact_response = \"in_solver\" needs the instrumented soft-body solver (HostSimulationOptions::solver_node_bounds)");
+      if (soft.m_clusters.size() != 0 || soft.m_cfg.diterations != 0 || soft.m_cfg.piterations <= 0)
+        throw std::invalid_argument("contact_response = \"in_solver\" needs a soft body with position iterations, no clusters and no drift iterations");
+      for (int p = 0; p < parts; ++p) solver->add_contact(collisions_[static_cast<std::size_t>(p)]->solver_contact());
     }
   }
   const ToolVolume volume = build_volume(scene_);
@@ -174,7 +185,11 @@ const HostStepResult& HostSimulation::step(const ToolPose& tool_target, double j
     tool_pose_ = interpolate(from, tool_target, a);
     jaw_gap_m_ = clamp ? gap_from + a * (gap_target - gap_from) : 0.0;
     tool_part_poses(scene_, tool_pose_, jaw_gap_m_, part_poses_);
-    for (int p = 0; p < parts; ++p) world_->set_part_pose(p, part_poses_[static_cast<std::size_t>(p)]);
+    for (int p = 0; p < parts; ++p) {
+      const auto k = static_cast<std::size_t>(p);
+      world_->set_part_pose(p, part_poses_[k]);
+      collisions_[k]->prepare_step(previous[k], part_poses_[k], h);  // in_solver: detected and solved inside the step
+    }
     const Clock::time_point bullet_start = Clock::now();
     world_->step(h);
     result_.times.bullet_s += seconds_since(bullet_start);
@@ -185,6 +200,9 @@ const HostStepResult& HostSimulation::step(const ToolPose& tool_target, double j
       collisions_[k]->step(previous[k], part_poses_[k], h, world_->soft(), r);
       // bullet's collision ran inside stepSimulation (measured by the probe); ours runs here.
       result_.times.collision_s += method_ == SceneCollisionMethod::kBullet ? r.seconds_narrow + r.seconds_response : seconds_since(collision_start);
+      // In-solver, the detection and the projections ran inside Bullet's step: they are ours.
+      result_.times.collision_s += r.seconds_in_solver;
+      result_.times.bullet_s -= r.seconds_in_solver;
     }
     previous = part_poses_;
     // The metrics follow every sub-step: the crossing tracker judges each node's relative path

@@ -46,16 +46,31 @@ void NodeBoundsSolver::solve_with_bounds(btSoftBody& sb) {
   sb.m_cfg.piterations = 0;
   sb.solveConstraints();
   sb.m_cfg.piterations = position_iterations;
-  // 2. Its position block, verbatim: the same solvers in the same order with the same ti.
+  // 2. The contacts decide this step's contact set on the predicted positions; their broad phase
+  //    reads the bounds of m_q and the predicted m_x.
+  if (!contacts_.empty()) {
+    take_bounds(sb, false);
+    for (SoftContactConstraint* contact : contacts_) contact->begin_solve(sb);
+  }
+  // 3. Its position block, verbatim: the same solvers in the same order with the same ti, each
+  //    iteration followed by the contacts' projection.
   for (int isolve = 0; isolve < position_iterations; ++isolve) {
     const btScalar ti = isolve / static_cast<btScalar>(position_iterations);
     for (int iseq = 0; iseq < sb.m_cfg.m_psequence.size(); ++iseq) btSoftBody::getSolver(sb.m_cfg.m_psequence[iseq])(&sb, 1, ti);
+    for (SoftContactConstraint* contact : contacts_) contact->project(sb);
   }
-  // 3. Its velocity update (the same float operations per component, so the same results), with
-  //    the bounds of m_q and m_x taken in the same pass, one block of nodes at a time. Bullet's
-  //    btVector3 arithmetic is scalar here (Linux builds leave BT_USE_SSE_IN_API off): written
-  //    with btVector3::setMin/setMax the bounds cost ~50 instructions a node (callgrind); on SSE
-  //    four lanes at a time they cost 4.
+  // 4. Its velocity update with the bounds taken in the same pass; what follows it in Bullet
+  //    (drift: excluded above; dampClusters / applyClusters(true): no-ops without clusters, and
+  //    already run in step 1).
+  take_bounds(sb, true);
+}
+
+void NodeBoundsSolver::take_bounds(btSoftBody& sb, bool velocity_update) {
+  // Bullet's velocity update (the same float operations per component, so the same results), with
+  // the bounds of m_q and m_x taken in the same pass, one block of nodes at a time. Bullet's
+  // btVector3 arithmetic is scalar here (Linux builds leave BT_USE_SSE_IN_API off): written with
+  // btVector3::setMin/setMax the bounds cost ~50 instructions a node (callgrind); on SSE four
+  // lanes at a time they cost 4.
   const btScalar vc = sb.m_sst.isdt * (1 - sb.m_cfg.kDP);
   const int count = sb.m_nodes.size();
   btVector3 all_lo(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT), all_hi(-BT_LARGE_FLOAT, -BT_LARGE_FLOAT, -BT_LARGE_FLOAT);
@@ -68,8 +83,10 @@ void NodeBoundsSolver::solve_with_bounds(btSoftBody& sb) {
     for (int i = first; i < last; ++i) {
       btSoftBody::Node& n = sb.m_nodes[i];
       const __m128 x = _mm_load_ps(n.m_x.m_floats), q = _mm_load_ps(n.m_q.m_floats);
-      _mm_store_ps(n.m_v.m_floats, _mm_mul_ps(_mm_sub_ps(x, q), vc4));
-      _mm_store_ps(n.m_f.m_floats, _mm_setzero_ps());
+      if (velocity_update) {
+        _mm_store_ps(n.m_v.m_floats, _mm_mul_ps(_mm_sub_ps(x, q), vc4));
+        _mm_store_ps(n.m_f.m_floats, _mm_setzero_ps());
+      }
       lo4 = _mm_min_ps(lo4, _mm_min_ps(x, q));
       hi4 = _mm_max_ps(hi4, _mm_max_ps(x, q));
     }
@@ -80,8 +97,10 @@ void NodeBoundsSolver::solve_with_bounds(btSoftBody& sb) {
     hi = lo;
     for (int i = first; i < last; ++i) {
       btSoftBody::Node& n = sb.m_nodes[i];
-      n.m_v = (n.m_x - n.m_q) * vc;
-      n.m_f = btVector3(0, 0, 0);
+      if (velocity_update) {
+        n.m_v = (n.m_x - n.m_q) * vc;
+        n.m_f = btVector3(0, 0, 0);
+      }
       lo.setMin(n.m_x);
       lo.setMin(n.m_q);
       hi.setMax(n.m_x);
@@ -96,8 +115,6 @@ void NodeBoundsSolver::solve_with_bounds(btSoftBody& sb) {
   bounds_.all_lo = all_lo;
   bounds_.all_hi = all_hi;
   bounds_.valid = count > 0;
-  // 4. What follows the velocity update in Bullet (drift: excluded above; dampClusters /
-  //    applyClusters(true): no-ops without clusters, and already run in step 1).
 }
 
 }  // namespace fissure::host

@@ -45,6 +45,21 @@ std::optional<SceneCollisionMethod> parse_collision_method(std::string_view name
   return std::nullopt;
 }
 
+const char* to_string(ContactResponse response) noexcept {
+  switch (response) {
+    case ContactResponse::kAfterStep: return "after_step";
+    case ContactResponse::kInSolver: return "in_solver";
+  }
+  return "?";
+}
+
+std::optional<ContactResponse> parse_contact_response(std::string_view name) noexcept {
+  for (const ContactResponse response : {ContactResponse::kAfterStep, ContactResponse::kInSolver}) {
+    if (name == to_string(response)) return response;
+  }
+  return std::nullopt;
+}
+
 namespace {
 
 using config::child_path;
@@ -60,6 +75,9 @@ void read_simulation(TableReader& t, SimulationDescription& sim) {
   std::vector<std::pair<std::string, SceneCollisionMethod>> methods;
   for (const SceneCollisionMethod method : kCollisionMethods) methods.emplace_back(to_string(method), method);
   sim.collision_method = t.choice<SceneCollisionMethod>("collision_method", methods);
+  sim.contact_response = t.choice<ContactResponse>(
+      "contact_response", {{to_string(ContactResponse::kAfterStep), ContactResponse::kAfterStep}, {to_string(ContactResponse::kInSolver), ContactResponse::kInSolver}},
+      ContactResponse::kAfterStep);
   t.finish();
 }
 

@@ -25,7 +25,21 @@ using Clock = std::chrono::steady_clock;
 constexpr double kInsideTolerance_m = 1e-7;
 double seconds_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
-class ThinBodyCollisionImpl final : public ThinBodyCollision {
+// What the detection stages (1–4: broad phase, node sweep, pair exclusion, placement) found in a
+// step, kept from the solve to the step() that reports it (in-solver response).
+struct DetectionReport {
+  bool broad_phase_hit = false;
+  int colliding_tool_nodes = 0;
+  int excluded_pairs = 0;
+  int both_face_contacts = 0;
+  int displaced_soft_nodes = 0;
+  int guard_corrections = 0;
+  double seconds_broad = 0.0;
+  double seconds_narrow = 0.0;
+  double seconds_response = 0.0;
+};
+
+class ThinBodyCollisionImpl final : public ThinBodyCollision, public SoftContactConstraint {
  public:
   ThinBodyCollisionImpl(const ToolNodes& tool, const btSoftBody& soft, const ThinBodyCollisionParams& params, bool paired,
                         SoftNodeBounds* node_bounds)
@@ -38,53 +52,68 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision {
     if (&soft != soft_ || soft.m_nodes.size() != model_.soft.node_count || soft.m_faces.size() != model_.soft.face_count)
       throw std::invalid_argument("thin-body collision: step() got a different soft body than at construction");
     if (!(dt_s > 0.0) || !std::isfinite(dt_s)) throw std::invalid_argument("thin-body collision: dt_s must be > 0");
-    const Clock::time_point t0 = Clock::now();
-    ++data_.step;
     out.force_on_tool_world_n.setZero();
     out.contacts.clear();
     if (out.contacts.capacity() < static_cast<std::size_t>(model_.soft.face_count))
       out.reserve_for(model_.soft.face_count);  // first call only
-    out.colliding_tool_nodes = 0;
-    out.excluded_pairs = 0;
-    out.both_face_contacts = 0;
+    if (in_solver()) {
+      if (!solved_)
+        throw std::logic_error("thin-body collision (in_solver): step() without a solve of the prepared step — call prepare_step(), "
+                               "then step the world whose NodeBoundsSolver holds solver_contact()");
+      solved_ = false;
+    } else {
+      detect_and_place(previous, current, dt_s, soft);
+    }
+    out.colliding_tool_nodes = report_.colliding_tool_nodes;
+    out.excluded_pairs = report_.excluded_pairs;
+    out.both_face_contacts = report_.both_face_contacts;
+    out.displaced_soft_nodes = report_.displaced_soft_nodes;
+    out.guard_corrections = report_.guard_corrections;
+    out.broad_phase_hit = report_.broad_phase_hit;
+    out.seconds_broad = report_.seconds_broad;
+    out.seconds_narrow = report_.seconds_narrow;
+    out.seconds_response = report_.seconds_response;
+    out.seconds_force = 0.0;
+    out.seconds_in_solver = in_solver() ? report_.seconds_broad + report_.seconds_narrow + report_.seconds_response : 0.0;
     out.contacted_triangles = 0;
-    out.displaced_soft_nodes = 0;
-    out.guard_corrections = 0;
-    out.seconds_narrow = out.seconds_response = out.seconds_force = 0.0;
-
-    if (!had_contact_ && thin_body::broad_phase_out_of_reach(model_, previous, current, node_bounds_, data_)) {
-      out.broad_phase_hit = false;
-      out.seconds_broad = seconds_between(t0, Clock::now());
-      return;
+    if (!report_.broad_phase_hit) return;
+    const Clock::time_point t0 = Clock::now();
+    if (in_solver()) {
+      thin_body::take_solved_shares(model_, frame_, soft, data_);
+    } else {
+      thin_body::hold_near_nodes(model_, frame_, data_);
     }
-    frame_ = thin_body::make_step_frame(model_, data_.step, previous, current, dt_s);
-    out.broad_phase_hit = thin_body::broad_phase(model_, frame_, soft, data_, node_bounds_);
+    thin_body::collect_force_faces(model_, frame_, data_);
     const Clock::time_point t1 = Clock::now();
-    out.seconds_broad = seconds_between(t0, t1);
-    if (!out.broad_phase_hit) {
-      // Out of contact: nothing else runs; the tool nodes' contact memory ends here.
-      if (had_contact_) {
-        std::fill(data_.node_face.begin(), data_.node_face.end(), -1);
-        std::fill(data_.node_age.begin(), data_.node_age.end(), 0);
-        had_contact_ = false;
-      }
-      return;
-    }
-    had_contact_ = true;
-    thin_body::sweep_tool_nodes(model_, data_);
-    out.both_face_contacts = thin_body::exclude_infeasible_pairs(model_, data_);
-    out.excluded_pairs = static_cast<int>(data_.exclusion.size());
-    out.colliding_tool_nodes = static_cast<int>(data_.contact_nodes.size()) - out.excluded_pairs;
-    const Clock::time_point t2 = Clock::now();
-    out.seconds_narrow = seconds_between(t1, t2);
-    const thin_body::DisplacementCounts counts = thin_body::enforce_displacement(model_, frame_, soft, data_, node_bounds_);
-    out.displaced_soft_nodes = counts.displaced;
-    out.guard_corrections = counts.guard_corrections;
-    const Clock::time_point t3 = Clock::now();
-    out.seconds_response = seconds_between(t2, t3);
+    out.seconds_response += seconds_between(t0, t1);
     thin_body::hunt_crossley_force(model_, frame_, soft, data_, out);
     out.contacted_triangles = static_cast<int>(data_.contacted_faces.size());
-    out.seconds_force = seconds_between(t3, Clock::now());
+    out.seconds_force = seconds_between(t1, Clock::now());
+  }
+
+  [[nodiscard]] SoftContactConstraint* solver_contact() noexcept override { return in_solver() ? this : nullptr; }
+
+  void prepare_step(const ToolPose& previous, const ToolPose& current, double dt_s) override {
+    if (!in_solver()) return;
+    if (!(dt_s > 0.0) || !std::isfinite(dt_s)) throw std::invalid_argument("thin-body collision: dt_s must be > 0");
+    pending_previous_ = previous;
+    pending_current_ = current;
+    pending_dt_s_ = dt_s;
+    pending_ = true;
+  }
+
+  void begin_solve(btSoftBody& soft) override {
+    if (!pending_ || &soft != soft_) return;  // a step nobody prepared: the body is solved without this contact
+    pending_ = false;
+    detect_and_place(pending_previous_, pending_current_, pending_dt_s_, soft);
+    solved_ = true;
+  }
+
+  void project(btSoftBody& soft) override {
+    if (!solved_ || !report_.broad_phase_hit || &soft != soft_) return;
+    const Clock::time_point t0 = Clock::now();
+    report_.guard_corrections += thin_body::project_contacts(model_, frame_, soft, data_);
+    report_.seconds_response += seconds_between(t0, Clock::now());
   }
 
   void reset_rest_state(const btSoftBody& soft) override {
@@ -102,6 +131,8 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision {
     thin_body::allocate_collision_data(model_, data_);
     data_.step = step;
     had_contact_ = false;
+    pending_ = false;
+    solved_ = false;
     return put_out_nodes_inside(previous, current, soft);
   }
 
@@ -110,6 +141,44 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision {
   }
 
  private:
+  [[nodiscard]] bool in_solver() const noexcept { return model_.params.response == ContactResponse::kInSolver; }
+
+  // Stages 1–4 on the body's m_q (start of the step) and m_x (its end: after Bullet's step for
+  // after_step, Bullet's prediction for in_solver): detection, and the contacted nodes placed.
+  void detect_and_place(const ToolPose& previous, const ToolPose& current, double dt_s, btSoftBody& soft) {
+    const Clock::time_point t0 = Clock::now();
+    ++data_.step;
+    report_ = DetectionReport{};
+    if (!had_contact_ && thin_body::broad_phase_out_of_reach(model_, previous, current, node_bounds_, data_)) {
+      report_.seconds_broad = seconds_between(t0, Clock::now());
+      return;
+    }
+    frame_ = thin_body::make_step_frame(model_, data_.step, previous, current, dt_s);
+    report_.broad_phase_hit = thin_body::broad_phase(model_, frame_, soft, data_, node_bounds_);
+    const Clock::time_point t1 = Clock::now();
+    report_.seconds_broad = seconds_between(t0, t1);
+    if (!report_.broad_phase_hit) {
+      // Out of contact: nothing else runs; the tool nodes' contact memory ends here.
+      if (had_contact_) {
+        std::fill(data_.node_face.begin(), data_.node_face.end(), -1);
+        std::fill(data_.node_age.begin(), data_.node_age.end(), 0);
+        had_contact_ = false;
+      }
+      return;
+    }
+    had_contact_ = true;
+    thin_body::sweep_tool_nodes(model_, data_);
+    report_.both_face_contacts = thin_body::exclude_infeasible_pairs(model_, data_);
+    report_.excluded_pairs = static_cast<int>(data_.exclusion.size());
+    report_.colliding_tool_nodes = static_cast<int>(data_.contact_nodes.size()) - report_.excluded_pairs;
+    const Clock::time_point t2 = Clock::now();
+    report_.seconds_narrow = seconds_between(t1, t2);
+    const thin_body::DisplacementCounts counts = thin_body::place_contact_nodes(model_, frame_, soft, data_, node_bounds_);
+    report_.displaced_soft_nodes = counts.displaced;
+    report_.guard_corrections = counts.guard_corrections;
+    report_.seconds_response = seconds_between(t2, Clock::now());
+  }
+
   // reseat(): every free soft node inside the tool at `current` onto a face + skin (see the
   // interface for which face and why).
   int put_out_nodes_inside(const ToolPose& previous, const ToolPose& current, btSoftBody& soft) const {
@@ -164,6 +233,13 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision {
   const btSoftBody* soft_;
   SoftNodeBounds* node_bounds_;  // the solver's node bounds (null: the broad phase reads every node)
   bool had_contact_ = false;
+  DetectionReport report_;
+  // In-solver: the step prepare_step() announced, not yet detected (pending_), and detected inside
+  // the solve but not yet reported by step() (solved_).
+  ToolPose pending_previous_, pending_current_;
+  double pending_dt_s_ = 0.0;
+  bool pending_ = false;
+  bool solved_ = false;
 };
 
 }  // namespace

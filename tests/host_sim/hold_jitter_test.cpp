@@ -85,14 +85,17 @@ struct HoldOracleCheck {
 // The mandatory invariants in every cell: no crossed node, penetration ≤ 0.1 mm, and the held
 // tool still presses the ball. The jitter is printed (the table for the issue's note). On every
 // hold step the cut-triangle and inside-node counts must agree with the FCL oracle's; the cut
-// count itself is not asserted to be zero (today's design leaves some: issue 22).
-TEST_P(PairedSweepHold, NoCrossingNoPenetrationAndContactAtEverySpeed) {
-  const PlungeTool& tool = plunge_tools()[static_cast<std::size_t>(GetParam())];
-  const SceneDescription scene = plunge_scene(tool);
+// count itself is not asserted to be zero (issue 22's open target; the figures are printed).
+// `expect_no_crossing` false: everything but the crossed count is asserted (the in-solver
+// response's open defect, below); no node may still be inside the tool after any hold step.
+void check_every_speed(const PlungeTool& tool, ContactResponse response, bool expect_no_crossing = true) {
+  SceneDescription scene = plunge_scene(tool);
+  scene.simulation.contact_response = response;
   // One sub-step per host step: the tracker's inside count (worst sub-step) is then the count at
   // the pose the oracle is asked about.
   ASSERT_EQ(scene.simulation.substeps_count, 1);
   const test_oracle::FclToolOracle oracle = oracle_for(scene);
+  const std::string label = std::string(tool.name) + (response == ContactResponse::kInSolver ? " [in_solver]" : "");
   for (const double speed : kSpeedsMS) {
     HoldOracleCheck check{oracle, {}, {}, 0, 0};
     const PlungeHoldResult c = run_plunge_hold(scene, SceneCollisionMethod::kPaired, speed, tool.leading_half_m, kHoldS, true,
@@ -102,24 +105,44 @@ TEST_P(PairedSweepHold, NoCrossingNoPenetrationAndContactAtEverySpeed) {
     const int set_changes = c.hold_contact_set_changes;
     const Vec3& a = c.ball_centre_hold_start_world_m;
     const Vec3& b = c.ball_centre_hold_end_world_m;
-    std::printf("%-17s %5.1f m/s: crossed %d, penetration %.4f mm, F_hold %.3f N, jitter %.3f %% | contact-set changes %d, "
+    std::printf("%-29s %5.1f m/s: crossed %d, penetration %.4f mm, F_hold %.3f N, jitter %.3f %% | contact-set changes %d, "
                 "ball centre moved (%.1f, %.1f) mm in x, z over the hold | cut triangles max %d, on %d of %zu hold steps\n",
-                std::string(tool.name).c_str(), speed, c.crossed_nodes, c.max_penetration_m * 1e3, c.hold.mean_n, 100.0 * c.hold.jitter,
+                label.c_str(), speed, c.crossed_nodes, c.max_penetration_m * 1e3, c.hold.mean_n, 100.0 * c.hold.jitter,
                 set_changes, (b[0] - a[0]) * 1e3, (b[2] - a[2]) * 1e3, c.hold_max_cut_triangles, c.hold_steps_with_cut_triangles,
                 c.hold_force_n.size());
     const test_oracle::RunTally& t = check.tally;
-    std::printf("%-17s %5.1f m/s: oracle over %d hold steps: cut triangles max %d on %d steps (project max %d on %d), "
+    std::printf("%-29s %5.1f m/s: oracle over %d hold steps: cut triangles max %d on %d steps (project max %d on %d), "
                 "steps whose counts differ %ld (outside the margin %d); nodes inside max %d (project %d), differ %ld (outside %d)\n",
-                std::string(tool.name).c_str(), speed, t.steps, t.oracle_max_cut, t.oracle_steps_with_cut, t.project_max_cut,
+                label.c_str(), speed, t.steps, t.oracle_max_cut, t.oracle_steps_with_cut, t.project_max_cut,
                 t.project_steps_with_cut, t.triangles_differ, check.cut_outside_bracket, t.oracle_max_inside, t.project_max_inside,
                 t.nodes_differ, check.inside_outside_bracket);
-    EXPECT_EQ(c.crossed_nodes, 0) << tool.name << " at " << speed << " m/s";
-    EXPECT_LE(c.max_penetration_m, kMaxPenetrationM) << tool.name << " at " << speed << " m/s";
-    EXPECT_GT(c.hold.mean_n, 0.0) << tool.name << " at " << speed << " m/s: the held tool lost the ball";
+    if (expect_no_crossing) {
+      EXPECT_EQ(c.crossed_nodes, 0) << label << " at " << speed << " m/s";
+    }
+    EXPECT_EQ(t.project_max_inside, 0) << label << " at " << speed << " m/s: a node ended a step inside the tool";
+    EXPECT_LE(c.max_penetration_m, kMaxPenetrationM) << label << " at " << speed << " m/s";
+    EXPECT_GT(c.hold.mean_n, 0.0) << label << " at " << speed << " m/s: the held tool lost the ball";
     EXPECT_EQ(t.steps, static_cast<int>(c.hold_force_n.size())) << "the oracle saw every hold step";
-    EXPECT_EQ(check.cut_outside_bracket, 0) << tool.name << " at " << speed << " m/s: the oracle and triangles_cut_by_tool disagree";
-    EXPECT_EQ(check.inside_outside_bracket, 0) << tool.name << " at " << speed << " m/s: the oracle and the tracker disagree on nodes inside";
+    EXPECT_EQ(check.cut_outside_bracket, 0) << label << " at " << speed << " m/s: the oracle and triangles_cut_by_tool disagree";
+    EXPECT_EQ(check.inside_outside_bracket, 0) << label << " at " << speed << " m/s: the oracle and the tracker disagree on nodes inside";
   }
+}
+
+TEST_P(PairedSweepHold, NoCrossingNoPenetrationAndContactAtEverySpeed) {
+  check_every_speed(plunge_tools()[static_cast<std::size_t>(GetParam())], ContactResponse::kAfterStep);
+}
+
+// The response solved inside Bullet's position iterations (contact_response = "in_solver",
+// experimental): no node ends a step inside the tool, penetration ≤ 0.1 mm, the oracle agrees.
+TEST_P(PairedSweepHold, InSolverNoNodeInsideNoPenetrationAndContactAtEverySpeed) {
+  check_every_speed(plunge_tools()[static_cast<std::size_t>(GetParam())], ContactResponse::kInSolver, false);
+}
+
+// ... and no crossed node. NOT MET (disabled so that it stays visible): the 1 mm plate and the
+// convex spatula at 0.1 m/s cross 1 node each (docs/decisions.md, "Contact inside the solver",
+// 2026-12-04).
+TEST_P(PairedSweepHold, DISABLED_InSolverNoCrossingAtEverySpeed) {
+  check_every_speed(plunge_tools()[static_cast<std::size_t>(GetParam())], ContactResponse::kInSolver);
 }
 
 // The issue's hold-jitter target, ≤ 1 % in every cell. NOT MET (disabled so that it stays

@@ -150,6 +150,19 @@ TEST(SceneLoader, CollisionMethodNamesParseBackAndNothingElseDoes) {
   EXPECT_EQ(parse_collision_method("Paired"), std::nullopt);
 }
 
+// [simulation] contact_response: optional (after_step, the paper's order), "in_solver" read, any
+// other text refused with its line and the names that work.
+TEST(SceneLoader, ContactResponseIsOptionalAndChecked) {
+  const std::string good = read(kScenes / "spatula-sphere.toml");
+  EXPECT_EQ(load_scene_text(good, "good.toml", kScenes).simulation.contact_response, ContactResponse::kAfterStep);
+  const std::string in_solver = replace(good, "collision_method = \"paired\"", "collision_method = \"paired\"\ncontact_response = \"in_solver\"");
+  EXPECT_EQ(load_scene_text(in_solver, "in_solver.toml", kScenes).simulation.contact_response, ContactResponse::kInSolver);
+  const std::string bad = replace(good, "collision_method = \"paired\"", "collision_method = \"paired\"\ncontact_response = \"inside\"");
+  expect_error(load_error(bad), line_of(bad, "contact_response"), "simulation.contact_response", "'inside' is not one of: after_step, in_solver");
+  for (const ContactResponse r : {ContactResponse::kAfterStep, ContactResponse::kInSolver}) EXPECT_EQ(parse_contact_response(to_string(r)), r);
+  EXPECT_EQ(parse_contact_response("In_Solver"), std::nullopt);
+}
+
 TEST(SceneLoader, ShapeMatchingIsOptionalAndRangeChecked) {
   const std::string shipped = read(kScenes / "spatula-sphere.toml");
   EXPECT_EQ(load_scene_text(shipped, "good.toml", kScenes).soft_body.shape_matching_ratio, 0.05);

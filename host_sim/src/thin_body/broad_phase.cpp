@@ -137,7 +137,7 @@ struct Query {
 constexpr double kStretchAllowance = 2.0;
 double seed_reach_m(const CollisionModel& model) { return kStretchAllowance * model.soft.max_rest_edge_m; }
 
-double near_pad_m(const CollisionModel& model) { return model.params.contact_distance_m + model.params.skin_m; }
+double near_pad_m(const CollisionModel& model) { return model.near_pad_m; }
 double release_pad_m(const CollisionModel& model) { return std::max(model.params.contact_distance_m, model.params.release_distance_m) + model.params.skin_m; }
 double memory_pad_m(const CollisionModel& model) { return model.memory_depth_m + model.params.contact_distance_m; }
 

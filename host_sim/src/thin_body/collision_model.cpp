@@ -89,6 +89,8 @@ CollisionModel build_collision_model(const ToolNodes& tool, const btSoftBody& so
     throw std::invalid_argument("thin-body collision: release_distance_m must be >= 0");
   if (!(params.velocity_filter_cutoff_hz > 0.0))
     throw std::invalid_argument("thin-body collision: velocity_filter_cutoff_hz must be > 0");
+  if (!(params.solver_reach_m >= 0.0) || !std::isfinite(params.solver_reach_m))
+    throw std::invalid_argument("thin-body collision: solver_reach_m must be >= 0 (finite)");
   const auto& hc = params.hunt_crossley;
   if (!(hc.k >= 0.0) || !(hc.lambda >= 0.0) || !(hc.n > 0.0) || !std::isfinite(hc.k) || !std::isfinite(hc.lambda) ||
       !std::isfinite(hc.n))
@@ -119,7 +121,9 @@ CollisionModel build_collision_model(const ToolNodes& tool, const btSoftBody& so
   // A node already in contact may start a step this far behind its triangle (the soft solver
   // pushing a held node back a little) and still be in contact; further behind is another surface.
   model.memory_depth_m = std::max(tool.thickness_m(), 10.0 * params.contact_distance_m);
-  const double near_pad_m = params.contact_distance_m + params.skin_m;
+  model.near_pad_m = params.contact_distance_m + params.skin_m +
+                     (params.response == ContactResponse::kInSolver ? params.solver_reach_m : 0.0);
+  const double near_pad_m = model.near_pad_m;
   model.near_sphere_centre_tool_m = tool.bounds_tool_m().center();
   model.near_sphere_radius_m = 0.5 * (tool.bounds_tool_m().sizes() + Eigen::Vector3d::Constant(2.0 * near_pad_m)).norm();
   model.rim_plane.assign(tool.planes().size(), 0);

@@ -69,6 +69,10 @@ struct CollisionModel {
   // triangle placed on a rim plane takes ALL its free vertices onto that plane whenever the move
   // does not pass through the tool (enforced_displacement.cpp).
   std::vector<std::uint8_t> rim_plane;
+  // How far from the tool's bounds a soft face is collected by the broad phase: contact_distance
+  // + skin, plus solver_reach_m for the in-solver response (nodes Bullet's iterations may pull
+  // into the tool after the detection ran on the predicted positions).
+  double near_pad_m = 0.0;
 };
 
 // Per-step frame quantities.
@@ -179,6 +183,19 @@ struct DisplacementCounts {
 // broad phase later in the same step still reads conservative bounds.
 DisplacementCounts enforce_displacement(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft,
                                         CollisionData& data, SoftNodeBounds* node_bounds = nullptr);
+// enforce_displacement's three parts: place the contacted nodes (and guard), keep last step's held
+// nodes within release_distance colliding (after_step's hysteresis), and collect the force set
+// (every face around a colliding node) into contacted_faces.
+DisplacementCounts place_contact_nodes(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft, CollisionData& data,
+                                       SoftNodeBounds* node_bounds);
+void hold_near_nodes(const CollisionModel& model, const StepFrame& frame, CollisionData& data);
+void collect_force_faces(const CollisionModel& model, const StepFrame& frame, CollisionData& data);
+// The in-solver response (solver_projection.cpp): after each of Bullet's position iterations, the
+// held nodes behind their plane and the free candidate nodes inside the tool back out on a face
+// (returns how many were moved); after the solve, every held node's share of the force from its
+// final gap, the colliding nodes listed in moved_nodes.
+int project_contacts(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft, CollisionData& data);
+void take_solved_shares(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data);
 // Stage 5 (hunt_crossley_force.cpp): HC per contacted triangle, summed; fills out.contacts.
 void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft,
                          CollisionData& data, CollisionStepResult& out);

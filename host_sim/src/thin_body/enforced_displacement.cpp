@@ -133,19 +133,6 @@ struct Writer {
     return segment_clears_tool(a, target_on_plane(node, plane_index));
   }
 
-  // A face with a colliding soft node enters the force set on the plane that node is held on (the
-  // first colliding node found decides). A tool node that hit the face this step is kept as its
-  // leading node only if it lies on that same plane.
-  void add_force_face(int face, int plane_index) {
-    const auto f = static_cast<std::size_t>(face);
-    if (data.face_force_stamp[f] == frame.step) return;
-    data.face_force_stamp[f] = frame.step;
-    const bool hit_on_same_plane = data.face_contact_stamp[f] == frame.step && data.face_plane[f] == plane_index;
-    if (!hit_on_same_plane) data.face_lead_node[f] = -1;
-    data.face_plane[f] = plane_index;
-    data.contacted_faces.push_back(face);
-  }
-
   void paired_faces() {
     const double feasible_slack = model.params.contact_distance_m + model.params.skin_m;
     for (const int face : data.contacted_faces) {
@@ -232,8 +219,8 @@ struct Writer {
 
 }  // namespace
 
-DisplacementCounts enforce_displacement(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft,
-                                        CollisionData& data, SoftNodeBounds* node_bounds) {
+DisplacementCounts place_contact_nodes(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft, CollisionData& data,
+                                       SoftNodeBounds* node_bounds) {
   Writer writer{model, frame, soft, data, DisplacementCounts{}};
   data.moved_nodes.clear();
   if (model.paired) {
@@ -245,6 +232,10 @@ DisplacementCounts enforce_displacement(const CollisionModel& model, const StepF
   // Every node written above is listed in moved_nodes (Writer::write).
   if (node_bounds != nullptr)
     for (const int node : data.moved_nodes) node_bounds->extend(node, soft.m_nodes[node].m_x);
+  return writer.counts;
+}
+
+void hold_near_nodes(const CollisionModel& model, const StepFrame& frame, CollisionData& data) {
   // Hysteresis: a node held last step and still within release_distance in front of its plane
   // stays colliding (not moved), with a share of its force that ramps (smoothstep) from 1 on the
   // face to 0 at release_distance (normal_displacement, hunt_crossley_force.cpp): the node's force
@@ -267,6 +258,26 @@ DisplacementCounts enforce_displacement(const CollisionModel& model, const StepF
     data.moved_stamp[n] = frame.step;
     data.moved_nodes.push_back(node);
   }
+}
+
+namespace {
+
+// A face with a colliding soft node enters the force set on the plane that node is held on (the
+// first colliding node found decides). A tool node that hit the face this step is kept as its
+// leading node only if it lies on that same plane.
+void add_force_face(const StepFrame& frame, CollisionData& data, int face, int plane_index) {
+  const auto f = static_cast<std::size_t>(face);
+  if (data.face_force_stamp[f] == frame.step) return;
+  data.face_force_stamp[f] = frame.step;
+  const bool hit_on_same_plane = data.face_contact_stamp[f] == frame.step && data.face_plane[f] == plane_index;
+  if (!hit_on_same_plane) data.face_lead_node[f] = -1;
+  data.face_plane[f] = plane_index;
+  data.contacted_faces.push_back(face);
+}
+
+}  // namespace
+
+void collect_force_faces(const CollisionModel& model, const StepFrame& frame, CollisionData& data) {
   // Paper: "the calculation of x is executed if and only if at least one of the nodes belonging to
   // the triangle is in a colliding state" — the force set is every triangle around a colliding
   // soft node (displaced this step, or held within the release distance).
@@ -274,9 +285,16 @@ DisplacementCounts enforce_displacement(const CollisionModel& model, const StepF
   for (const int node : data.moved_nodes) {
     const auto n = static_cast<std::size_t>(node);
     for (int k = model.soft.faces_of_node_begin[n]; k < model.soft.faces_of_node_begin[n + 1]; ++k)
-      writer.add_force_face(model.soft.faces_of_node[static_cast<std::size_t>(k)], data.hold_plane[n]);
+      add_force_face(frame, data, model.soft.faces_of_node[static_cast<std::size_t>(k)], data.hold_plane[n]);
   }
-  return writer.counts;
+}
+
+DisplacementCounts enforce_displacement(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft,
+                                        CollisionData& data, SoftNodeBounds* node_bounds) {
+  const DisplacementCounts counts = place_contact_nodes(model, frame, soft, data, node_bounds);
+  hold_near_nodes(model, frame, data);
+  collect_force_faces(model, frame, data);
+  return counts;
 }
 
 }  // namespace fissure::host::thin_body

@@ -6,12 +6,17 @@
 
 #include <nlohmann/json.hpp>
 
+#include "fissure/host_sim/scene_description.hpp"
+
 namespace fissure::eval {
 
 struct BenchCollisionOptions {
   bool quick = false;              ///< CI-sized: fewer speeds and meshes, shorter holds
   bool full = false;               ///< more timing samples per cost-vs-mesh row; the same cells
   std::vector<std::string> only;   ///< parts to run (empty: all): sweep, cells, indentation, scaling
+  /// Where the paired / ray response acts in every scene the bench runs (the solver A/B of part 4
+  /// stays after_step: it compares Bullet's stock solver, which cannot host the in-solver one).
+  host::ContactResponse contact_response = host::ContactResponse::kAfterStep;
   [[nodiscard]] bool runs(const char* part) const;
 };
 

@@ -76,6 +76,9 @@ class BulletCollision final : public ThinBodyCollision {
   /// each step (SDF_RS), and its contact pushes out nodes inside the part along the SDF gradient.
   int reseat(const ToolPose& /*previous*/, const ToolPose& /*current*/, btSoftBody& /*soft*/) override { return 0; }
   [[nodiscard]] SceneCollisionMethod method() const override { return SceneCollisionMethod::kBullet; }
+  // Bullet's own contact is always solved inside its step: nothing to add or prepare.
+  [[nodiscard]] SoftContactConstraint* solver_contact() noexcept override { return nullptr; }
+  void prepare_step(const ToolPose& /*previous*/, const ToolPose& /*current*/, double /*dt_s*/) override {}
 
  private:
   const ContactProbeSolver& probe_;

@@ -54,19 +54,40 @@ struct SoftNodeBounds {
   }
 };
 
+// A contact solved inside the attached body's position iterations (the thin-body collision's
+// in-solver response, issue 22): Bullet's links, anchors and rigid contacts and this contact are
+// iterated together, so they converge together in every step.
+class SoftContactConstraint {
+ public:
+  virtual ~SoftContactConstraint() = default;
+  // After Bullet's prediction (m_q: start of the step, m_x: predicted end) and before the position
+  // iterations, with the bounds of both valid: decide this step's contacts and place their nodes.
+  virtual void begin_solve(btSoftBody& soft) = 0;
+  // After every position iteration: put the contacts' nodes back where the contact allows them.
+  virtual void project(btSoftBody& soft) = 0;
+};
+
 class NodeBoundsSolver : public btDefaultSoftBodySolver {
  public:
   // Keep bounds for this body (one per solver; other bodies get Bullet's stock solve).
   void attach(btSoftBody* soft);
   [[nodiscard]] SoftNodeBounds& bounds() noexcept { return bounds_; }
+  // Solve `contact` with the attached body, in the order added (a clamp: one per jaw). Not owned:
+  // it must outlive the solver or be removed by clear_contacts().
+  void add_contact(SoftContactConstraint* contact) { contacts_.push_back(contact); }
+  void clear_contacts() noexcept { contacts_.clear(); }
 
   void solveConstraints(btScalar solver_dt) override;
 
  private:
   void solve_with_bounds(btSoftBody& soft);
+  // The bounds of every node's m_q and m_x; with `velocity_update` Bullet's velocity update is
+  // fused into the same pass (node_bounds_solver.cpp).
+  void take_bounds(btSoftBody& soft, bool velocity_update);
 
   btSoftBody* soft_ = nullptr;
   SoftNodeBounds bounds_;
+  std::vector<SoftContactConstraint*> contacts_;
 };
 
 }  // namespace fissure::host

@@ -32,6 +32,17 @@ inline constexpr std::array<SceneCollisionMethod, 3> kCollisionMethods{SceneColl
 /// The method whose to_string() is `name`; nullopt for any other text (the caller says where it came from).
 [[nodiscard]] std::optional<SceneCollisionMethod> parse_collision_method(std::string_view name) noexcept;
 
+/// Where the paired / ray response acts (issue 22): after Bullet's step, overwriting the node
+/// positions it solved ("after_step", the paper's order), or as constraints projected inside the
+/// soft-body solver's position iterations, so the contact and the body's links converge together
+/// ("in_solver"; docs/decisions.md, "Contact inside the solver").
+enum class ContactResponse : std::uint8_t { kAfterStep, kInSolver };
+
+/// Its name in scene files and on the command line: "after_step", "in_solver".
+[[nodiscard]] const char* to_string(ContactResponse response) noexcept;
+/// The response whose to_string() is `name`; nullopt for any other text.
+[[nodiscard]] std::optional<ContactResponse> parse_contact_response(std::string_view name) noexcept;
+
 /// A rigid pose: position of the tool frame origin and its orientation, world frame.
 struct Pose {
   Vec3 position_world_m{0.0, 0.0, 0.0};
@@ -169,6 +180,7 @@ struct SimulationDescription {
   int substeps_count = 1;           ///< Bullet internal steps per host step
   Vec3 gravity_world_m_per_s2{0.0, -9.81, 0.0};
   SceneCollisionMethod collision_method = SceneCollisionMethod::kPaired;
+  ContactResponse contact_response = ContactResponse::kAfterStep;  ///< paired / ray only
 };
 
 /// The scripted tool trajectory used by `fissure sim`: straight legs at constant speed; a

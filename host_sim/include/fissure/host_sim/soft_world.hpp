@@ -69,6 +69,8 @@ class SoftWorld {
   [[nodiscard]] ContactProbeSolver* probe() noexcept { return probe_; }
   /// Non-null only when the tool does not collide in Bullet (and the solver is not the stock one).
   [[nodiscard]] SoftNodeBounds* node_bounds() noexcept { return bounding_solver_ != nullptr ? &bounding_solver_->bounds() : nullptr; }
+  /// The solver behind node_bounds() (it also solves the in-solver contacts); null as above.
+  [[nodiscard]] NodeBoundsSolver* node_bounds_solver() noexcept { return bounding_solver_; }
   [[nodiscard]] double sdf_voxel_m() const noexcept { return sdf_voxel_m_; }
   /// Soft nodes tied to the ground by [[soft_body.anchor]] (0: a free body).
   [[nodiscard]] int anchored_nodes_count() const noexcept { return anchored_nodes_count_; }

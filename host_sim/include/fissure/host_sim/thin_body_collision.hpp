@@ -22,7 +22,8 @@ class btSoftBody;
 
 namespace fissure::host {
 
-struct SoftNodeBounds;  // node_bounds_solver.hpp
+struct SoftNodeBounds;         // node_bounds_solver.hpp
+class SoftContactConstraint;  // node_bounds_solver.hpp
 
 struct ThinBodyCollisionParams {
   HuntCrossleyParams hunt_crossley;
@@ -47,6 +48,14 @@ struct ThinBodyCollisionParams {
   double velocity_filter_cutoff_hz = 100.0;
   // Reported in ContactRecord::jaw so that a clamp can run one instance per jaw.
   int jaw = 0;
+  // Where the response acts (scene_description.hpp): after Bullet's step (the call order above)
+  // or inside its position iterations (solver_contact(), prepare_step()).
+  ContactResponse response = ContactResponse::kAfterStep;
+  // In-solver: soft faces this much beyond contact_distance from the tool (at the predicted
+  // positions) are candidates too, so that a node the solver's iterations pull towards the tool
+  // is projected out of it. 1 mm: a link pulls a node at most its share of the held nodes'
+  // displacement in one step; the hold-and-sweep tests check no node ends inside.
+  double solver_reach_m = 1.0e-3;
 };
 
 // One contacted soft triangle (what the proxy builder needs: a plane per contact, which tool face
@@ -78,12 +87,14 @@ struct CollisionStepResult {
   int both_face_contacts = 0;     // pairs with both nodes pushing (always 0 for paired; ray's instability)
   int contacted_triangles = 0;    // triangles with a colliding soft node (= contacts.size())
   int displaced_soft_nodes = 0;   // soft nodes written by the enforced displacement
-  int guard_corrections = 0;      // soft nodes the swept soft-node guard had to put back (paired only)
+  int guard_corrections = 0;      // soft nodes the swept soft-node guard had to put back (paired only); in_solver:
+                                  // plus the projections of the position iterations (a node moved twice counts twice)
   bool broad_phase_hit = false;
   double seconds_broad = 0.0;
   double seconds_narrow = 0.0;
   double seconds_response = 0.0;
   double seconds_force = 0.0;
+  double seconds_in_solver = 0.0;  // in_solver: of the above, what ran inside Bullet's solve (detection, placement, projections)
 
   // Reserve capacity for a soft body with this many faces (call once, before the loop).
   void reserve_for(int soft_face_count) { contacts.reserve(static_cast<std::size_t>(soft_face_count)); }
@@ -117,6 +128,13 @@ class ThinBodyCollision {
   // the tool. Returns the number of nodes put out. Does not allocate.
   virtual int reseat(const ToolPose& previous, const ToolPose& current, btSoftBody& soft) = 0;
   [[nodiscard]] virtual SceneCollisionMethod method() const = 0;
+
+  // In-solver response only (params.response == kInSolver): the constraint the world's
+  // NodeBoundsSolver solves with the body (null for after_step), and the poses of the coming
+  // Bullet step, given before it; step() after Bullet's step then reads the solved state and
+  // computes the force (it places nothing).
+  [[nodiscard]] virtual SoftContactConstraint* solver_contact() noexcept = 0;
+  virtual void prepare_step(const ToolPose& previous, const ToolPose& current, double dt_s) = 0;
 };
 
 // The soft body must have triangle faces (btSoftBody::m_faces); its rest state (rest centroids,

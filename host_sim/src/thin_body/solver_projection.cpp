@@ -1,0 +1,143 @@
+// The in-solver response (ContactResponse::kInSolver, issue 22): the contacts the detection stages
+// decided at the start of Bullet's step are held inside the soft body's position iterations, and
+// after the solve each held node's force share is read from where the solve left it.
+//
+// Why inside the solve: the post-step response overwrites node positions after Bullet's solve,
+// and Bullet's next solve (links, pose matching, anchors) pulls the held nodes back — a limit
+// cycle between two solvers that makes the held force chatter and keeps an opened clamp's nodes
+// on its jaws (docs/decisions.md, "Contact inside the solver"). Projected after every position
+// iteration, the contact and the body's own constraints converge together, and the velocity
+// Bullet derives from the projected positions (v = (x − q)/h) is the velocity of the node on the
+// face: no velocity is written here.
+//
+// project_contacts, after each iteration, on every candidate node (tool frame, current pose):
+//  * a node held on a plane this step (placed by the detection, or caught by an earlier
+//    iteration) and now behind that plane goes back on it (+ skin);
+//  * a free node the iteration pulled inside the tool volume goes out on the plane it was held
+//    on last step if that one faces a way out within a tool thickness, else on the plane its
+//    relative path start → now entered through (Cyrus–Beck), else on the nearest plane; it is
+//    held from then on. So no node ends the solve inside the tool.
+// take_solved_shares, after the solve: a held node's share of the force is the smoothstep of its
+// final gap over release_distance (1 on the face, 0 at release), as the post-step hysteresis
+// ramps it; a node beyond release_distance or behind its plane is released.
+#include "collision_state.hpp"
+
+#include <BulletSoftBody/btSoftBody.h>
+
+#include <limits>
+
+namespace fissure::host::thin_body {
+namespace {
+
+// A node counts as inside the tool only beyond this depth (float noise of positions written at
+// +skin; enforced_displacement.cpp's tolerance).
+constexpr double kInsideTolerance_m = 1e-7;
+
+Eigen::Vector3d to_tool(const StepFrame& frame, const btVector3& x_world) {
+  return frame.r_cur.transpose() * (Eigen::Vector3d(x_world.x(), x_world.y(), x_world.z()) - frame.t_cur);
+}
+
+void write_tool_position(const StepFrame& frame, const Eigen::Vector3d& p_tool, btSoftBody::Node& node) {
+  const Eigen::Vector3d p_world = frame.r_cur * p_tool + frame.t_cur;
+  node.m_x.setValue(static_cast<btScalar>(p_world.x()), static_cast<btScalar>(p_world.y()), static_cast<btScalar>(p_world.z()));
+}
+
+// The plane a free node found inside the tool leaves by (see the file comment for the order).
+int exit_plane(const CollisionModel& model, const StepFrame& frame, const CollisionData& data, int node,
+               const Eigen::Vector3d& p_tool) {
+  const auto& planes = model.tool.planes();
+  const auto n = static_cast<std::size_t>(node);
+  const double reach_m = model.tool.thickness_m() + model.params.skin_m;
+  if (data.hold_stamp[n] == frame.step - 1 && data.hold_plane[n] >= 0) {
+    const ToolPlane& held = planes[static_cast<std::size_t>(data.hold_plane[n])];
+    if (held.offset_m - held.normal_tool.dot(p_tool) <= reach_m) return data.hold_plane[n];
+  }
+  const Eigen::Vector3d& a = data.start_tool_m[n];
+  double t_enter = 0.0;
+  int enter_plane = -1;
+  int nearest_plane = 0;
+  double nearest_height = -std::numeric_limits<double>::infinity();
+  for (std::size_t q = 0; q < planes.size(); ++q) {
+    const double fa = planes[q].normal_tool.dot(a) - planes[q].offset_m;
+    const double fb = planes[q].normal_tool.dot(p_tool) - planes[q].offset_m;
+    if (fb > nearest_height) {
+      nearest_height = fb;
+      nearest_plane = static_cast<int>(q);
+    }
+    if (fa > 0.0 && fb < 0.0) {
+      const double t = fa / (fa - fb);
+      if (t >= t_enter) {
+        t_enter = t;
+        enter_plane = static_cast<int>(q);
+      }
+    }
+  }
+  if (enter_plane >= 0) {
+    const ToolPlane& entered = planes[static_cast<std::size_t>(enter_plane)];
+    if (entered.offset_m - entered.normal_tool.dot(p_tool) <= reach_m) return enter_plane;
+  }
+  return nearest_plane;
+}
+
+}  // namespace
+
+int project_contacts(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft, CollisionData& data) {
+  const auto& planes = model.tool.planes();
+  const double skin_m = model.params.skin_m;
+  int projected = 0;
+  for (const int node : data.candidate_nodes) {
+    btSoftBody::Node& soft_node = soft.m_nodes[node];
+    if (soft_node.m_im == 0) continue;  // fixed nodes are never moved
+    const auto n = static_cast<std::size_t>(node);
+    Eigen::Vector3d p = to_tool(frame, soft_node.m_x);
+    int plane_index = -1;
+    if (data.hold_stamp[n] == frame.step) {
+      const ToolPlane& held = planes[static_cast<std::size_t>(data.hold_plane[n])];
+      if (held.normal_tool.dot(p) >= held.offset_m + skin_m) continue;
+      plane_index = data.hold_plane[n];
+    } else {
+      double depth_m = -std::numeric_limits<double>::infinity();  // signed distance to the tool, < 0 inside
+      for (const ToolPlane& plane : planes) depth_m = std::max(depth_m, plane.normal_tool.dot(p) - plane.offset_m);
+      if (depth_m >= -kInsideTolerance_m) continue;
+      plane_index = exit_plane(model, frame, data, node, p);
+      data.hold_stamp[n] = frame.step;
+      data.hold_plane[n] = plane_index;
+    }
+    const ToolPlane& plane = planes[static_cast<std::size_t>(plane_index)];
+    p += (plane.offset_m + skin_m - plane.normal_tool.dot(p)) * plane.normal_tool;
+    write_tool_position(frame, p, soft_node);
+    ++projected;
+  }
+  return projected;
+}
+
+void take_solved_shares(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data) {
+  const auto& planes = model.tool.planes();
+  const double release_m = model.params.release_distance_m;
+  data.moved_nodes.clear();
+  for (const int node : data.candidate_nodes) {
+    const auto n = static_cast<std::size_t>(node);
+    const bool held = data.hold_stamp[n] == frame.step || data.hold_stamp[n] == frame.step - 1;
+    if (!held || soft.m_nodes[node].m_im == 0) {
+      if (data.moved_stamp[n] == frame.step) data.moved_stamp[n] = frame.step - 1;
+      continue;
+    }
+    const Eigen::Vector3d p = to_tool(frame, soft.m_nodes[node].m_x);
+    data.end_tool_m[n] = p;
+    const ToolPlane& plane = planes[static_cast<std::size_t>(data.hold_plane[n])];
+    const double gap_m = plane.normal_tool.dot(p) - plane.offset_m;
+    if (gap_m > release_m || gap_m < -kInsideTolerance_m) {
+      // Lifted off beyond the release band, or left behind the plane beside the tool: released.
+      if (data.hold_stamp[n] == frame.step) data.hold_stamp[n] = frame.step - 2;
+      if (data.moved_stamp[n] == frame.step) data.moved_stamp[n] = frame.step - 1;
+      continue;
+    }
+    const double u = release_m > 0.0 ? std::max(0.0, gap_m) / release_m : 0.0;
+    data.node_share[n] = 1.0 - u * u * (3.0 - 2.0 * u);  // smoothstep: flat on the face and at the release
+    data.hold_stamp[n] = frame.step;
+    data.moved_stamp[n] = frame.step;
+    data.moved_nodes.push_back(node);
+  }
+}
+
+}  // namespace fissure::host::thin_body
