@@ -22,6 +22,9 @@ struct TetMesh {
   std::vector<std::array<int, 4>> tetrahedra;
   /// The line each tetrahedron was read from (text formats), 1-based; empty for generated meshes.
   std::vector<int> tetrahedron_lines;
+  /// How many inverted elements a reader turned round (swapped its last two corners): a file
+  /// written with the other orientation convention has all of them; 0 for generated meshes.
+  int reordered_count = 0;
 };
 
 }  // namespace fissure::host
