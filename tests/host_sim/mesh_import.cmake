@@ -5,3 +5,4 @@ fissure_add_test(host_sim_mesh_checks_test SOURCES mesh_checks_test.cpp LIBS fis
 fissure_add_test(host_sim_mesh_bvh_test SOURCES mesh_bvh_test.cpp LIBS fissure_host_sim)
 fissure_add_test(host_sim_tool_mesh_io_test SOURCES tool_mesh_io_test.cpp LIBS fissure_host_sim)
 fissure_add_test(host_sim_soft_body_builder_test SOURCES soft_body_builder_test.cpp LIBS fissure_host_sim)
+fissure_add_test(host_sim_tet_mesh_file_test SOURCES tet_mesh_file_test.cpp LIBS fissure_host_sim)
