@@ -6,3 +6,4 @@ fissure_add_test(host_sim_mesh_bvh_test SOURCES mesh_bvh_test.cpp LIBS fissure_h
 fissure_add_test(host_sim_tool_mesh_io_test SOURCES tool_mesh_io_test.cpp LIBS fissure_host_sim)
 fissure_add_test(host_sim_soft_body_builder_test SOURCES soft_body_builder_test.cpp LIBS fissure_host_sim)
 fissure_add_test(host_sim_tet_mesh_file_test SOURCES tet_mesh_file_test.cpp LIBS fissure_host_sim)
+fissure_add_test(host_sim_tet_mesh_checks_test SOURCES tet_mesh_checks_test.cpp LIBS fissure_host_sim)
