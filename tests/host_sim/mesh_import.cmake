@@ -7,3 +7,8 @@ fissure_add_test(host_sim_tool_mesh_io_test SOURCES tool_mesh_io_test.cpp LIBS f
 fissure_add_test(host_sim_soft_body_builder_test SOURCES soft_body_builder_test.cpp LIBS fissure_host_sim)
 fissure_add_test(host_sim_tet_mesh_file_test SOURCES tet_mesh_file_test.cpp LIBS fissure_host_sim)
 fissure_add_test(host_sim_tet_mesh_checks_test SOURCES tet_mesh_checks_test.cpp LIBS fissure_host_sim)
+# A real TetGen run in the soft body test when the Debian tetgen is installed (it skips, saying so, otherwise).
+find_program(FISSURE_TETGEN tetgen)
+if(FISSURE_TETGEN)
+  target_compile_definitions(host_sim_soft_body_builder_test PRIVATE FISSURE_TETGEN_EXECUTABLE="${FISSURE_TETGEN}")
+endif()
