@@ -88,17 +88,25 @@ btSoftBody* create_from_tet_mesh(btSoftBodyWorldInfo& world_info, const VolumeMe
   }
   std::vector<btScalar> masses(mass_kg.begin(), mass_kg.end());
   auto* body = new btSoftBody(&world_info, count, count > 0 ? &x[0] : nullptr, count > 0 ? masses.data() : nullptr);
+  // The edges first, so Bullet's arrays are reserved once: grown by doubling, its large Tetra
+  // records (~0.4 kB each) are copied and their fresh pages faulted in again at every doubling.
   std::unordered_set<std::uint64_t> seen;
   seen.reserve(7 * mesh.tetrahedra.size() / 4 + 16);  // a tetrahedral mesh has ~1.2 edges per tetrahedron
+  std::vector<std::array<int, 2>> edges;
+  edges.reserve(7 * mesh.tetrahedra.size() / 4 + 16);
   constexpr int kEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
   for (const auto& t : mesh.tetrahedra) {
     for (const auto& e : kEdges) {
       const int i = t[static_cast<std::size_t>(e[0])], j = t[static_cast<std::size_t>(e[1])];
       const auto a = static_cast<std::uint32_t>(i), b = static_cast<std::uint32_t>(j);
-      if (seen.insert((static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b)).second) body->appendLink(i, j);
+      if (seen.insert((static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b)).second) edges.push_back({i, j});
     }
-    body->appendTetra(t[0], t[1], t[2], t[3]);
   }
+  body->m_links.reserve(static_cast<int>(edges.size()));
+  body->m_tetras.reserve(static_cast<int>(mesh.tetrahedra.size()));
+  body->m_faces.reserve(static_cast<int>(mesh.boundary_triangles.size()));
+  for (const auto& e : edges) body->appendLink(e[0], e[1]);
+  for (const auto& t : mesh.tetrahedra) body->appendTetra(t[0], t[1], t[2], t[3]);
   for (const auto& f : mesh.boundary_triangles) body->appendFace(f[0], f[1], f[2]);
   body->randomizeConstraints();
   return body;
