@@ -139,16 +139,16 @@ TetBoundary check_tet_mesh(const TetMesh& mesh) {
     std::size_t end = begin;
     while (end < faces.size() && faces[end].key == faces[begin].key) ++end;
     const Face& f = faces[begin];
-    const std::string vertices = "face " + std::to_string(f.key[0] + 1) + "–" + std::to_string(f.key[1] + 1) + "–" + std::to_string(f.key[2] + 1);
+    const auto vertices = [&f] { return "face " + std::to_string(f.key[0] + 1) + "–" + std::to_string(f.key[1] + 1) + "–" + std::to_string(f.key[2] + 1); };
     if (end - begin == 1) {
       boundary.push_back(&f);
     } else if (end - begin > 2) {
-      fail(f.tet, "non-manifold: its " + vertices + " is shared by " + std::to_string(end - begin) + " tetrahedra (" + std::to_string(faces[begin + 1].tet + 1) + ", " +
+      fail(f.tet, "non-manifold: its " + vertices() + " is shared by " + std::to_string(end - begin) + " tetrahedra (" + std::to_string(faces[begin + 1].tet + 1) + ", " +
                       std::to_string(faces[begin + 2].tet + 1) + (end - begin > 3 ? ", …" : "") + "); an inner face has 2");
     } else {
       const Face& g = faces[begin + 1];
       if (f.odd == g.odd) {
-        fail(g.tet, "overlaps tetrahedron " + std::to_string(f.tet + 1) + ": both lie on the same side of their shared " + vertices);
+        fail(g.tet, "overlaps tetrahedron " + std::to_string(f.tet + 1) + ": both lie on the same side of their shared " + vertices());
       }
       parent[static_cast<std::size_t>(find_root(parent, f.tet))] = find_root(parent, g.tet);
     }
