@@ -9,7 +9,7 @@
 // Orientation (tet_mesh.hpp): a linear tetrahedron's corner order carries nothing but its
 // orientation, so an inverted element (negative signed volume, a writer with the other
 // convention) is turned round by swapping its last two corners and counted in reordered_count;
-// an element whose |volume| is at most kDegenerateVolumeRelative × (mesh diagonal)³ is refused.
+// an element whose 6·|volume| is at most kDegenerateVolumeRelative × (mesh diagonal)³ is refused.
 //
 // Errors (MeshError, mesh_file.hpp) name the file, the line, the element or node as the file
 // numbers it (Gmsh tag, VTK cell id from 0, TetGen number), what is wrong and the range
