@@ -7,7 +7,10 @@
 // the 41k and 362k tools again as binary and ASCII STL (read and check only: the rest is the
 // OBJ row's), and tilted to the axes (tilted_row); and soft bodies from the organ-like lobe (make_organ_blob) at 1280, 20480 and
 // 327680 triangles: read = read_soft_body_mesh (parse + closed-surface checks), build =
-// build_soft_body (the Bullet body with its links, as a scene's world builds it).
+// build_soft_body (the Bullet body with its links, as a scene's world builds it); and
+// tetrahedral meshes of a box (tet_row: n³ cubes of 6 Kuhn tetrahedra, n = 10, 20, 40: 6,000,
+// 48,000 and 384,000 tetrahedra) in each format: read = read_soft_body_tet_mesh (parse, weld,
+// boundary and checks), build = create_from_tet_mesh (nodes, links, tetras, faces).
 //   nodes — ToolNodes::from_convex_mesh: a node per triangle, coplanar planes merged, pairing rays;
 //   volume — ToolVolume::from_convex_mesh: the metrics' planes and footprint;
 //   load = read + nodes + volume (what `fissure sim` pays before the first step).
@@ -15,6 +18,7 @@
 
 #include <unistd.h>
 
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -34,6 +38,7 @@
 #include "fissure/host_sim/contact_metrics.hpp"
 #include "fissure/host_sim/mesh_checks.hpp"
 #include "fissure/host_sim/soft_body_builder.hpp"
+#include "fissure/host_sim/tet_mesh.hpp"
 #include "fissure/host_sim/thin_tool.hpp"
 #include "fissure/host_sim/tool_mesh_io.hpp"
 #include "fissure/eval/sim_report.hpp"
@@ -218,6 +223,95 @@ nlohmann::json soft_row(int subdivisions, const fs::path& dir) {
   return row;
 }
 
+// A box of n³ cubes (1 mm each), each split into the 6 Kuhn tetrahedra along its (0,0,0)–(1,1,1)
+// diagonal: conforming, all positive (the permutations of even parity keep the order, the odd
+// ones swap the last two corners).
+host::TetMesh kuhn_box(int n) {
+  host::TetMesh m;
+  const auto id = [&](int i, int j, int k) { return (i * (n + 1) + j) * (n + 1) + k; };
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j)
+      for (int k = 0; k <= n; ++k) m.vertices_m.push_back({1e-3 * i, 1e-3 * j, 1e-3 * k});
+  constexpr int kPermutations[6][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1}, {0, 2, 1}, {1, 0, 2}, {2, 1, 0}};
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      for (int k = 0; k < n; ++k)
+        for (int p = 0; p < 6; ++p) {
+          std::array<int, 3> at{i, j, k};
+          std::array<int, 4> t{id(i, j, k), 0, 0, 0};
+          for (int s = 0; s < 3; ++s) {
+            ++at[static_cast<std::size_t>(kPermutations[p][s])];
+            t[static_cast<std::size_t>(s) + 1] = id(at[0], at[1], at[2]);
+          }
+          if (p >= 3) std::swap(t[2], t[3]);
+          m.tetrahedra.push_back(t);
+        }
+  return m;
+}
+
+void write_tet_file(const host::TetMesh& m, const fs::path& path, const std::string& format) {
+  std::ofstream out(path);
+  out.precision(9);
+  const std::size_t n = m.vertices_m.size();
+  if (format == "msh") {
+    out << "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 " << n << " 1 " << n << "\n3 1 0 " << n << "\n";
+    for (std::size_t i = 0; i < n; ++i) out << i + 1 << '\n';
+    for (const Vec3& v : m.vertices_m) out << v[0] << ' ' << v[1] << ' ' << v[2] << '\n';
+    out << "$EndNodes\n$Elements\n1 " << m.tetrahedra.size() << " 1 " << m.tetrahedra.size() << "\n3 1 4 " << m.tetrahedra.size() << '\n';
+    for (std::size_t t = 0; t < m.tetrahedra.size(); ++t) {
+      out << t + 1;
+      for (const int c : m.tetrahedra[t]) out << ' ' << c + 1;
+      out << '\n';
+    }
+    out << "$EndElements\n";
+  } else if (format == "vtk") {
+    out << "# vtk DataFile Version 3.0\nbench box\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS " << n << " double\n";
+    for (const Vec3& v : m.vertices_m) out << v[0] << ' ' << v[1] << ' ' << v[2] << '\n';
+    out << "CELLS " << m.tetrahedra.size() << ' ' << 5 * m.tetrahedra.size() << '\n';
+    for (const auto& t : m.tetrahedra) out << "4 " << t[0] << ' ' << t[1] << ' ' << t[2] << ' ' << t[3] << '\n';
+    out << "CELL_TYPES " << m.tetrahedra.size() << '\n';
+    for (std::size_t t = 0; t < m.tetrahedra.size(); ++t) out << "10\n";
+  } else {
+    out << n << " 3 0 0\n";
+    for (std::size_t i = 0; i < n; ++i) out << i + 1 << ' ' << m.vertices_m[i][0] << ' ' << m.vertices_m[i][1] << ' ' << m.vertices_m[i][2] << '\n';
+    std::ofstream ele(fs::path(path).replace_extension(".ele"));
+    ele << m.tetrahedra.size() << " 4 0\n";
+    for (std::size_t t = 0; t < m.tetrahedra.size(); ++t) ele << t + 1 << ' ' << m.tetrahedra[t][0] + 1 << ' ' << m.tetrahedra[t][1] + 1 << ' ' << m.tetrahedra[t][2] + 1 << ' ' << m.tetrahedra[t][3] + 1 << '\n';
+  }
+}
+
+nlohmann::json tet_row(int cells, const std::string& format, bool build, const fs::path& dir) {
+  const host::TetMesh box = kuhn_box(cells);
+  const fs::path path = dir / ("box-" + std::to_string(cells) + "." + (format == "tetgen" ? std::string("node") : format));
+  write_tet_file(box, path, format);
+  std::uintmax_t bytes = fs::file_size(path);
+  if (format == "tetgen") bytes += fs::file_size(fs::path(path).replace_extension(".ele"));
+  std::printf("box-%-3d        %-9s %9zu tets  ", cells, format.c_str(), box.tetrahedra.size());
+  std::fflush(stdout);
+  host::VolumeMesh loaded;
+  const double read_s = seconds_of([&] { loaded = host::read_soft_body_tet_mesh(path.string()); });
+  std::printf("read %8.3f s", read_s);
+  nlohmann::json row{{"mesh", "box-" + std::to_string(cells)}, {"format", format},  {"tetrahedra", box.tetrahedra.size()},
+                     {"vertices", box.vertices_m.size()},        {"file_bytes", bytes}, {"read_s", read_s},
+                     {"boundary_triangles", loaded.boundary_triangles.size()}};
+  if (build) {
+    int links = 0;
+    btSoftBodyWorldInfo info;
+    std::unique_ptr<btSoftBody> body;
+    const double build_s = seconds_of([&] { body.reset(host::create_from_tet_mesh(info, loaded, 1000.0)); });
+    links = body->m_links.size();
+    const double free_s = seconds_of([&] { body.reset(); });
+    std::printf("  build %8.3f s  (free %6.3f s; %d links, %zu boundary triangles)", build_s, free_s, links, loaded.boundary_triangles.size());
+    row["build_s"] = build_s;
+    row["free_s"] = free_s;
+    row["links"] = links;
+  }
+  std::printf("\n");
+  fs::remove(path);
+  if (format == "tetgen") fs::remove(fs::path(path).replace_extension(".ele"));
+  return row;
+}
+
 }  // namespace
 
 nlohmann::json run_bench_mesh(const BenchMeshOptions& options) {
@@ -253,6 +347,13 @@ nlohmann::json run_bench_mesh(const BenchMeshOptions& options) {
     soft.push_back(soft_row(subdivisions, dir));
   }
   out["soft_meshes"] = soft;
+  std::printf("tetrahedral meshes (box of n³ Kuhn cells):\n");
+  nlohmann::json tets = nlohmann::json::array();
+  for (const int cells : {10, 20, 40}) {
+    if (options.quick && cells == 40) continue;
+    for (const char* format : {"msh", "vtk", "tetgen"}) tets.push_back(tet_row(cells, format, std::string(format) == "msh", dir));
+  }
+  out["tet_meshes"] = tets;
   fs::remove_all(dir);
   return out;
 }

@@ -25,6 +25,7 @@
 #include "fissure/config/table_reader.hpp"
 
 #include "fissure/host_sim/soft_body_builder.hpp"
+#include "fissure/host_sim/tet_mesh_file.hpp"
 #include "fissure/host_sim/tool_mesh_io.hpp"
 
 namespace fissure::host {
@@ -168,12 +169,20 @@ void read_soft_body(const std::string& file, TableReader& t, SoftBodyDescription
     m.mesh_path = full.lexically_normal().string();
     m.offset_world_m = t.vec3("offset_world", "m", Vec3{0.0, 0.0, 0.0});
     try {
-      SurfaceMesh mesh = read_soft_body_mesh(m.mesh_path);
-      for (Vec3& v : mesh.vertices_m) {
+      // A tetrahedral file (.msh, .vtk, .node / .ele) makes a volumetric body, a surface file a shell.
+      if (is_tet_mesh_path(m.mesh_path)) {
+        VolumeMesh mesh = read_soft_body_tet_mesh(m.mesh_path);
+        m.vertices_world_m = std::move(mesh.vertices_m);
+        m.triangles = std::move(mesh.boundary_triangles);
+        m.tetrahedra = std::move(mesh.tetrahedra);
+      } else {
+        SurfaceMesh mesh = read_soft_body_mesh(m.mesh_path);
+        m.vertices_world_m = std::move(mesh.vertices_m);
+        m.triangles = std::move(mesh.triangles);
+      }
+      for (Vec3& v : m.vertices_world_m) {
         for (std::size_t k = 0; k < 3; ++k) v[k] += m.offset_world_m[k];
       }
-      m.vertices_world_m = std::move(mesh.vertices_m);
-      m.triangles = std::move(mesh.triangles);
     } catch (const std::exception& e) {
       t.fail(t.line_for("mesh_path", ""), "mesh_path", std::string("unreadable mesh: ") + e.what());
     }

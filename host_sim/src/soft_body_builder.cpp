@@ -19,6 +19,8 @@
 
 #include "fissure/host_sim/mesh_checks.hpp"
 #include "fissure/host_sim/mesh_file.hpp"
+#include "fissure/host_sim/tet_mesh_checks.hpp"
+#include "fissure/host_sim/tet_mesh_file.hpp"
 
 namespace fissure::host {
 
@@ -65,6 +67,47 @@ btSoftBody* create_from_tri_mesh(btSoftBodyWorldInfo& world_info, const std::vec
     }
     body->appendFace(t[0], t[1], t[2]);
   }
+  body->randomizeConstraints();
+  return body;
+}
+
+btSoftBody* create_from_tet_mesh(btSoftBodyWorldInfo& world_info, const VolumeMesh& mesh, double density_kg_per_m3) {
+  const int count = static_cast<int>(mesh.vertices_m.size());
+  btAlignedObjectArray<btVector3> x;
+  x.resize(count);
+  for (int i = 0; i < count; ++i) {
+    const Vec3& v = mesh.vertices_m[static_cast<std::size_t>(i)];
+    x[i] = btVector3(static_cast<btScalar>(v[0]), static_cast<btScalar>(v[1]), static_cast<btScalar>(v[2]));
+  }
+  std::vector<double> mass_kg(static_cast<std::size_t>(count), 0.0);
+  for (const auto& t : mesh.tetrahedra) {
+    const Eigen::Vector3d a = e3(mesh.vertices_m[static_cast<std::size_t>(t[0])]);
+    const double volume_m3 = (e3(mesh.vertices_m[static_cast<std::size_t>(t[1])]) - a)
+                                 .dot((e3(mesh.vertices_m[static_cast<std::size_t>(t[2])]) - a).cross(e3(mesh.vertices_m[static_cast<std::size_t>(t[3])]) - a)) / 6.0;
+    for (const int c : t) mass_kg[static_cast<std::size_t>(c)] += 0.25 * density_kg_per_m3 * volume_m3;
+  }
+  std::vector<btScalar> masses(mass_kg.begin(), mass_kg.end());
+  auto* body = new btSoftBody(&world_info, count, count > 0 ? &x[0] : nullptr, count > 0 ? masses.data() : nullptr);
+  // The edges first, so Bullet's arrays are reserved once: grown by doubling, its large Tetra
+  // records (~0.4 kB each) are copied and their fresh pages faulted in again at every doubling.
+  std::unordered_set<std::uint64_t> seen;
+  seen.reserve(7 * mesh.tetrahedra.size() / 4 + 16);  // a tetrahedral mesh has ~1.2 edges per tetrahedron
+  std::vector<std::array<int, 2>> edges;
+  edges.reserve(7 * mesh.tetrahedra.size() / 4 + 16);
+  constexpr int kEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+  for (const auto& t : mesh.tetrahedra) {
+    for (const auto& e : kEdges) {
+      const int i = t[static_cast<std::size_t>(e[0])], j = t[static_cast<std::size_t>(e[1])];
+      const auto a = static_cast<std::uint32_t>(i), b = static_cast<std::uint32_t>(j);
+      if (seen.insert((static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b)).second) edges.push_back({i, j});
+    }
+  }
+  body->m_links.reserve(static_cast<int>(edges.size()));
+  body->m_tetras.reserve(static_cast<int>(mesh.tetrahedra.size()));
+  body->m_faces.reserve(static_cast<int>(mesh.boundary_triangles.size()));
+  for (const auto& e : edges) body->appendLink(e[0], e[1]);
+  for (const auto& t : mesh.tetrahedra) body->appendTetra(t[0], t[1], t[2], t[3]);
+  for (const auto& f : mesh.boundary_triangles) body->appendFace(f[0], f[1], f[2]);
   body->randomizeConstraints();
   return body;
 }
@@ -205,10 +248,26 @@ SurfaceMesh read_soft_body_mesh(const std::string& path) {
   return mesh;
 }
 
+VolumeMesh read_soft_body_tet_mesh(const std::string& path) {
+  TetMesh tet = read_tet_mesh_file(path, kSoftMeshMaxTetrahedra);
+  (void)weld_and_compact(tet);
+  TetBoundary boundary = check_tet_mesh(tet);
+  VolumeMesh mesh;
+  mesh.vertices_m = std::move(tet.vertices_m);
+  mesh.tetrahedra = std::move(tet.tetrahedra);
+  mesh.boundary_triangles = std::move(boundary.triangles);
+  return mesh;
+}
+
 btSoftBody* build_soft_body(btSoftBodyWorldInfo& world_info, const SoftBodyDescription& d) {
   btSoftBody* body = nullptr;
   std::vector<int> pinned;
-  if (const auto* sphere = std::get_if<SoftSphere>(&d.shape); sphere != nullptr && sphere->tessellation == SphereTessellation::kBulletEllipsoid) {
+  const auto* volume = std::get_if<SoftMesh>(&d.shape);
+  if (volume != nullptr && !volume->tetrahedra.empty()) {
+    VolumeMesh mesh{volume->vertices_world_m, volume->tetrahedra, volume->triangles};
+    TetMesh tet{"", volume->vertices_world_m, volume->tetrahedra, {}, 0};
+    body = create_from_tet_mesh(world_info, mesh, d.mass_kg / tet_mesh_volume_m3(tet));
+  } else if (const auto* sphere = std::get_if<SoftSphere>(&d.shape); sphere != nullptr && sphere->tessellation == SphereTessellation::kBulletEllipsoid) {
     // CreateEllipsoid builds the convex hull of res + 3 points: 2·(res + 3) − 4 faces.
     const int res = (sphere->faces_count - 2) / 2;
     body = btSoftBodyHelpers::CreateEllipsoid(world_info, btVector3(static_cast<btScalar>(sphere->center_world_m[0]), static_cast<btScalar>(sphere->center_world_m[1]), static_cast<btScalar>(sphere->center_world_m[2])),

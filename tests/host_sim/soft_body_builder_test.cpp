@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -19,7 +21,11 @@
 
 #include "fissure/host_sim/host_simulation.hpp"
 #include "fissure/host_sim/scene_loader.hpp"
+#include "fissure/host_sim/soft_world.hpp"
+#include "fissure/host_sim/tet_mesh_checks.hpp"
+#include "fissure/host_sim/tet_mesh_file.hpp"
 #include "mesh_test_meshes.hpp"
+#include "tet_test_meshes.hpp"
 
 namespace fissure::host {
 namespace {
@@ -166,6 +172,115 @@ TEST(SoftBodyMesh, SceneLoaderNamesTheSceneLineAndField) {
     EXPECT_NE(what.find("soft_body.mesh_path"), std::string::npos) << what;
     EXPECT_NE(what.find("open.obj': triangle 5 (line 14): open"), std::string::npos) << what;
   }
+}
+
+// A volumetric body from a tetrahedral mesh: a node per vertex with its lumped share of
+// density × volume, a link per tetrahedron edge, a Bullet tetra per tetrahedron, the boundary
+// as outward faces.
+TEST(SoftBodyTetMesh, CreateFromTetMeshBuildsNodesLinksTetrasAndBoundaryFaces) {
+  const TetMesh box = test_tets::kuhn_box({3, 2, 4}, 0.01);
+  const TetBoundary boundary = check_tet_mesh(box);
+  const VolumeMesh mesh{box.vertices_m, box.tetrahedra, boundary.triangles};
+  constexpr double kDensity_kg_per_m3 = 1000.0;  // water; soft tissue is 1000–1100
+  btSoftBodyWorldInfo info;
+  const std::unique_ptr<btSoftBody> body(create_from_tet_mesh(info, mesh, kDensity_kg_per_m3));
+  ASSERT_EQ(body->m_nodes.size(), 4 * 3 * 5);
+  EXPECT_EQ(body->m_tetras.size(), 6 * 24);
+  EXPECT_EQ(body->m_faces.size(), static_cast<int>(boundary.triangles.size()));
+  // Edges of a Kuhn grid of nx × ny × nz cells: the axis edges, one diagonal per face square, one per cell.
+  const int nx = 3, ny = 2, nz = 4;
+  const int axis = nx * (ny + 1) * (nz + 1) + (nx + 1) * ny * (nz + 1) + (nx + 1) * (ny + 1) * nz;
+  const int squares = nx * ny * (nz + 1) + nx * (ny + 1) * nz + (nx + 1) * ny * nz;
+  EXPECT_EQ(body->m_links.size(), axis + squares + nx * ny * nz) << "one link per tetrahedron edge, shared edges once";
+  double total_kg = 0.0;
+  for (int i = 0; i < body->m_nodes.size(); ++i) total_kg += 1.0 / body->m_nodes[i].m_im;
+  EXPECT_NEAR(total_kg, kDensity_kg_per_m3 * 0.03 * 0.02 * 0.04, 1e-6 * 0.024) << "btScalar is float: 1e-6 relative";
+  // The corner (0, 0, 0) is a corner of one tetrahedron of each of its cell's 6 (all meet on
+  // the cell's diagonal): 6 × (1 cm³ / 6) / 4 of the density.
+  EXPECT_NEAR(1.0 / body->m_nodes[0].m_im, kDensity_kg_per_m3 * 1e-6 / 4.0, 1e-6 * 2.5e-4);
+  // Faces outward: each face normal points away from its tetrahedron's fourth corner.
+  for (int f = 0; f < body->m_faces.size(); ++f) {
+    const auto& face = body->m_faces[f];
+    const btVector3 n = (face.m_n[1]->m_x - face.m_n[0]->m_x).cross(face.m_n[2]->m_x - face.m_n[0]->m_x);
+    const btVector3 centre(0.015F, 0.01F, 0.02F);
+    const btVector3 middle = (face.m_n[0]->m_x + face.m_n[1]->m_x + face.m_n[2]->m_x) / 3;
+    EXPECT_GT(n.dot(middle - centre), 0.0F) << "face " << f << " faces out of the (convex) box";
+  }
+  for (int t = 0; t < body->m_tetras.size(); ++t) EXPECT_GT(body->m_tetras[t].m_rv, 0.0F) << "tetra " << t << "'s rest volume";
+}
+
+// A scene's [soft_body] shape = "mesh" with a TetGen file: a volumetric body of the scene's
+// mass, which settles on the ground under gravity (0.5 s, 1 kHz) with every node finite.
+TEST(SoftBodyTetMesh, SceneWithATetGenMeshSettlesFinite) {
+  const auto dir = test_meshes::scratch_dir("soft_body_tet_scene");
+  const std::string node_path = test_tets::write_tetgen(test_tets::kuhn_box({4, 2, 4}, 0.01), dir / "box");
+  std::string text;
+  {
+    std::ifstream in(kScenes / "spatula-blob.toml");
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const auto replace_line = [&](const std::string& key, const std::string& line) {
+    const std::size_t at = text.find("\n" + key);
+    ASSERT_NE(at, std::string::npos) << key;
+    text.replace(at + 1, text.find('\n', at + 1) - at - 1, line);
+  };
+  replace_line("mesh_path", "mesh_path = \"" + node_path + "\"");
+  replace_line("offset_world_m", "offset_world_m = [-0.02, 0.002, -0.02]");  // 40 × 20 × 40 mm, 2 mm (the soft margin) above the ground
+  std::ofstream(dir / "scene.toml") << text;
+  const SceneDescription scene = load_scene(dir / "scene.toml");
+  const auto* mesh = std::get_if<SoftMesh>(&scene.soft_body.shape);
+  ASSERT_NE(mesh, nullptr);
+  EXPECT_EQ(mesh->tetrahedra.size(), 6U * 32U);
+  EXPECT_EQ(mesh->triangles.size(), 4U * (4 * 2 + 2 * 4 + 4 * 4)) << "the box's boundary";
+  EXPECT_DOUBLE_EQ(mesh->vertices_world_m.front()[1], 0.002);
+  SoftWorld world(scene, false);
+  const btSoftBody& body = world.soft();
+  EXPECT_EQ(body.m_tetras.size(), 6 * 32);
+  double total_kg = 0.0;
+  for (int i = 0; i < body.m_nodes.size(); ++i) total_kg += 1.0 / body.m_nodes[i].m_im;
+  EXPECT_NEAR(total_kg, scene.soft_body.mass_kg, 1e-6 * scene.soft_body.mass_kg) << "the scene's mass, spread by volume";
+  for (int step = 0; step < 500; ++step) world.step(scene.simulation.time_step_s);
+  std::vector<Eigen::Vector3d> nodes;
+  world.copy_node_positions(nodes);
+  double lowest_m = 1.0, highest_m = -1.0;
+  for (const Eigen::Vector3d& p : nodes) {
+    ASSERT_TRUE(p.allFinite());
+    lowest_m = std::min(lowest_m, p.y());
+    highest_m = std::max(highest_m, p.y());
+  }
+  // Resting on the ground within its margin, neither fallen through nor blown up.
+  EXPECT_GT(lowest_m, -scene.soft_body.collision_margin_m);
+  EXPECT_LT(highest_m, 0.022 + 0.002);
+  EXPECT_GT(highest_m, 0.005) << "still a body, not a puddle";
+}
+
+// TetGen (the Debian package) tetrahedralises a closed STL; its .node/.ele load as a body.
+TEST(SoftBodyTetMesh, TetGenOutputOfAnStlLoads) {
+#ifndef FISSURE_TETGEN_EXECUTABLE
+  GTEST_SKIP() << "tetgen was not on PATH when the build was configured (apt-get install tetgen)";
+#else
+  const auto dir = test_meshes::scratch_dir("soft_body_tetgen_run");
+  const std::string stl = test_meshes::write_stl_ascii(test_meshes::cube(0.04, 0.03, 0.05), dir / "block.stl");
+  std::filesystem::remove(dir / "block.1.node");
+  // -p: a piecewise linear complex from the surface; -q1.4: radius-edge ratio ≤ 1.4; -a: the
+  // largest tetrahedron volume [m³]; -Q: quiet. Writes block.1.node / block.1.ele.
+  const std::string command = std::string(FISSURE_TETGEN_EXECUTABLE) + " -pq1.4a2e-6 -Q '" + stl + "'";
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  const VolumeMesh mesh = read_soft_body_tet_mesh((dir / "block.1.node").string());
+  EXPECT_GT(mesh.tetrahedra.size(), 100U);
+  double volume_m3 = 0.0;
+  for (const auto& t : mesh.tetrahedra) {
+    TetMesh one{"", mesh.vertices_m, {t}, {}, 0};
+    volume_m3 += tet_mesh_volume_m3(one);
+  }
+  EXPECT_NEAR(volume_m3, 0.04 * 0.03 * 0.05, 1e-12) << "the tetrahedra fill the block";
+  const TetMesh raw = read_tet_mesh_file((dir / "block.1.ele").string(), kSoftMeshMaxTetrahedra);
+  std::printf("tetgen: %zu points, %zu tetrahedra, %d turned round, %zu boundary triangles\n", raw.vertices_m.size(), raw.tetrahedra.size(),
+              raw.reordered_count, mesh.boundary_triangles.size());
+  btSoftBodyWorldInfo info;
+  const std::unique_ptr<btSoftBody> body(create_from_tet_mesh(info, mesh, 1000.0));
+  EXPECT_EQ(body->m_tetras.size(), static_cast<int>(mesh.tetrahedra.size()));
+#endif
 }
 
 }  // namespace

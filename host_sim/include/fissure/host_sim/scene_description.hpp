@@ -78,7 +78,9 @@ struct SoftSlab {
   std::array<int, 2> top_cells_count{16, 16};  ///< grid cells of the top face along x, z
 };
 
-/// A soft body from a closed surface mesh file (OBJ or STL, docs/scenes.md "Mesh files"): the
+/// A soft body from a mesh file (docs/scenes.md "Mesh files"): a closed surface (OBJ or STL), or
+/// a tetrahedral volume (Gmsh .msh, VTK .vtk, TetGen .node/.ele: read_soft_body_tet_mesh, a
+/// volumetric body whose triangles are the volume's boundary). The
 /// file's vertices in metres, moved by offset_world_m, counter-clockwise seen from outside; the
 /// loader reads it and refuses a mesh that is open, non-manifold, inconsistently or inward
 /// oriented, degenerate, several surfaces or too large (read_soft_body_mesh). Built like the
@@ -88,6 +90,8 @@ struct SoftMesh {
   Vec3 offset_world_m{0.0, 0.0, 0.0};         ///< where the file's origin goes in the world
   std::vector<Vec3> vertices_world_m;         ///< the file's vertices + offset_world_m (loaded and checked at load)
   std::vector<std::array<int, 3>> triangles;  ///< counter-clockwise seen from outside
+  /// A volume mesh's tetrahedra (positive, corners into vertices_world_m); empty for a surface mesh.
+  std::vector<std::array<int, 4>> tetrahedra;
 };
 
 /// Soft-body anchoring (tissue attached to its bed): every node whose REST position (the

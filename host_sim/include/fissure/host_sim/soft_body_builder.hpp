@@ -1,7 +1,9 @@
 #pragma once
 // Soft bodies of a scene as Bullet btSoftBody objects (triangle surface meshes with links
 // on the edges): the paper's sphere (Bullet's own CreateEllipsoid, 128 faces), geodesic
-// icospheres for mesh refinement, a closed cylinder (the vessel) and a slab.
+// icospheres for mesh refinement, a closed cylinder (the vessel) and a slab; and volumetric
+// bodies from a tetrahedral mesh file (nodes, a link per tetrahedron edge, Bullet tetras, the
+// boundary triangles as faces).
 #include <array>
 #include <cstddef>
 #include <string>
@@ -45,12 +47,39 @@ inline constexpr std::size_t kSoftMeshMaxTriangles = 400'000;
 /// line in a text format) and the reason.
 [[nodiscard]] SurfaceMesh read_soft_body_mesh(const std::string& path);
 
+/// The most tetrahedra a volumetric soft body may have: a million tetrahedra make ~1.2 million
+/// links and a million Bullet tetras, ~0.4 GB of btSoftBody (its Node, Link and Tetra records
+/// are ~100–200 bytes each), the size of the largest surface body's 400,000 triangles.
+inline constexpr std::size_t kSoftMeshMaxTetrahedra = 1'000'000;
+
+/// A volumetric soft body's mesh: tetrahedra positive (tet_mesh.hpp) and the boundary triangles
+/// counter-clockwise seen from outside.
+struct VolumeMesh {
+  std::vector<Vec3> vertices_m;
+  std::vector<std::array<int, 4>> tetrahedra;
+  std::vector<std::array<int, 3>> boundary_triangles;
+};
+
+/// Reads a soft body's tetrahedral mesh (.msh, .vtk, TetGen .node/.ele; tet_mesh_file.hpp),
+/// welds duplicate vertices, drops unused ones and checks it (tet_mesh_checks.hpp): one
+/// connected volume with a closed manifold boundary, no overlap, at most kSoftMeshMaxTetrahedra.
+/// Throws MeshError naming the file, the element (tetrahedron and its line) and the reason.
+[[nodiscard]] VolumeMesh read_soft_body_tet_mesh(const std::string& path);
+
+/// A volumetric btSoftBody: a node per vertex with the lumped mass density × (a quarter of the
+/// volume of each tetrahedron it is a corner of), a link per tetrahedron edge (once), a Bullet
+/// tetra per tetrahedron (btSoftBody::appendTetra, rest volume), the boundary triangles as
+/// faces (outward: the soft collisions take "outward" from the winding); then Bullet's
+/// deterministic randomizeConstraints, as create_from_tri_mesh. Linear in the mesh size.
+[[nodiscard]] btSoftBody* create_from_tet_mesh(btSoftBodyWorldInfo& world_info, const VolumeMesh& mesh, double density_kg_per_m3);
+
 /// btSoftBodyHelpers::CreateFromTriMesh(…, randomizeConstraints = true) in linear memory and
 /// time: the same nodes, links, faces and their order (xyz: 3 coordinates per vertex).
 [[nodiscard]] btSoftBody* create_from_tri_mesh(btSoftBodyWorldInfo& world_info, const std::vector<btScalar>& xyz,
                                                const std::vector<std::array<int, 3>>& triangles);
 
-/// Builds the scene's soft body (not yet added to a world) and applies its material and
+/// Builds the scene's soft body (not yet added to a world; a tetrahedral SoftMesh through
+/// create_from_tet_mesh with the density mass / volume, so mass_kg is spread by volume) and applies its material and
 /// config (kLST, kPR, kVC, kDP, kDF, piterations, margin, mass; kKHR = kCHR = 1, BRIEF §3).
 /// The caller owns the result (a btSoftRigidDynamicsWorld does not delete its bodies).
 [[nodiscard]] btSoftBody* build_soft_body(btSoftBodyWorldInfo& world_info, const SoftBodyDescription& description);
