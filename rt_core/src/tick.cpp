@@ -135,7 +135,12 @@ TickResult tick(const RtModel& model, RtData& data, TickIo& io, const TickTiming
   const std::uint32_t sample_faults = read_device(model, data, io.device, now_ns);
   data.have_position = sample_faults == 0;
   update_position_epoch(data, sample_faults);
-  if (history_break && data.have_position) restart_observer(data.passivity);
+  if (history_break && data.have_position) {
+    // The device held the command that was acting when the loop stalled while the hand moved:
+    // that work is exact (a zero-order hold held longer) and counts in E before the chain restarts.
+    observe_energy(data.passivity, data.p_device_m);
+    restart_observer(data.passivity);
+  }
   if (data.have_position) observe_energy(data.passivity, data.p_device_m);
   update_device_faults(model, data, sample_faults);
 

@@ -150,6 +150,29 @@ TEST(Tick, ProxySwapWhileTheToolMovesKeepsTheRenderedStepWithinTheBound) {
   EXPECT_NEAR(previous, kStiffness_n_per_m * (kNewPlaneY_m - force_y_m), 1e-9);
 }
 
+// Issue 26: across an rt stall the device held the command that was acting when the loop
+// stopped, and the hand's motion under it is work done as exactly as at any tick (a zero-order
+// hold held longer): the observer counts it before its chain restarts. Pressing 2 mm into the
+// wall under the held push, the hand paid F·Δp — the debt of the deeper contact is partly paid.
+TEST(Tick, WorkDoneUnderTheHeldForceDuringAStallIsObserved) {
+  Harness h;
+  h.settle();
+  h.publish(kStiffness_n_per_m);
+  h.step();
+  const Eigen::Vector3d held_n = h.data.passivity.force_acting_device_n;
+  ASSERT_GT(held_n.y(), 0.5);  // the wall pushes the hand out (+y)
+  const double energy_before_j = h.data.passivity.energy_j;
+  const Eigen::Vector3d p_before = h.data.p_device_m;
+  h.device.place(kCentre_device_m - Eigen::Vector3d(0.0, 0.002, 0.0));
+  h.now_ns += 100'000'000;  // 100 ms stall: far beyond the 10 ms history break
+  h.step();
+  const Eigen::Vector3d dp = h.data.p_device_m - p_before;
+  ASSERT_LT(dp.y(), -0.0015);  // the hand did press in
+  EXPECT_NEAR(h.data.passivity.energy_j, energy_before_j + held_n.dot(dp), 1e-12);
+  EXPECT_LT(h.data.passivity.energy_j, energy_before_j - 1e-3);  // > 1 mJ taken in by the held push
+  EXPECT_GT(h.data.passivity.recovery_window_left_s, 0.0);  // and the chain restarted (a history break)
+}
+
 TEST(Tick, StaleProxyFadesToZeroWithinItsBoundAndRecovers) {
   Harness h;
   h.settle();
