@@ -24,8 +24,8 @@ namespace {
 /// a device fault: the velocity filter restarts, and the passivity observer restarts its Δp chain
 /// and opens a recovery window (passivity.hpp). 10 ms is ten periods at 1 kHz: the wall was a
 /// sampled spring held ten times longer than the loop is built for, and the motion across the
-/// gap, paired with the one force that acted during it, says nothing about the contact's
-/// energy at the loop's rate.
+/// gap says nothing about the velocity at the loop's rate. Its work under the one command that
+/// acted during it is exact, though, and is counted before the observer restarts (tick()).
 constexpr double kHistoryBreakGap_s = 0.01;
 
 // Read device → encoder → angles → FK → velocity. Returns the device fault bits of this
