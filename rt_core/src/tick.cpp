@@ -5,6 +5,7 @@
 
 #include "fissure/shared/device_mapping.hpp"
 #include "fissure/rt_core/faults.hpp"
+#include "fissure/rt_core/force_position.hpp"
 #include "fissure/rt_core/forward_kinematics_stage.hpp"
 #include "fissure/rt_core/hunt_crossley.hpp"
 #include "fissure/rt_core/joint_angles.hpp"
@@ -23,8 +24,8 @@ namespace {
 /// a device fault: the velocity filter restarts, and the passivity observer restarts its Δp chain
 /// and opens a recovery window (passivity.hpp). 10 ms is ten periods at 1 kHz: the wall was a
 /// sampled spring held ten times longer than the loop is built for, and the motion across the
-/// gap, paired with the one force that acted during it, says nothing about the contact's
-/// energy at the loop's rate.
+/// gap says nothing about the velocity at the loop's rate. Its work under the one command that
+/// acted during it is exact, though, and is counted before the observer restarts (tick()).
 constexpr double kHistoryBreakGap_s = 0.01;
 
 // Read device → encoder → angles → FK → velocity. Returns the device fault bits of this
@@ -75,6 +76,7 @@ void update_device_faults(const RtModel& model, RtData& data, std::uint32_t new_
     // History is no longer trustworthy: restart the velocity filter and the observer's Δp
     // chain from the next good sample.
     data.velocity.primed = false;
+    data.force_position.primed = false;
     restart_observer(data.passivity);
     return;
   }
@@ -126,11 +128,19 @@ TickResult tick(const RtModel& model, RtData& data, TickIo& io, const TickTiming
   // 1. read device … velocity (after a stall the history restarts: kHistoryBreakGap_s)
   const bool history_break =
       data.joints.have_reference && to_seconds(now_ns - data.last_judged_sample_ns) > kHistoryBreakGap_s;
-  if (history_break) data.velocity.primed = false;
+  if (history_break) {
+    data.velocity.primed = false;
+    data.force_position.primed = false;
+  }
   const std::uint32_t sample_faults = read_device(model, data, io.device, now_ns);
   data.have_position = sample_faults == 0;
   update_position_epoch(data, sample_faults);
-  if (history_break && data.have_position) restart_observer(data.passivity);
+  if (history_break && data.have_position) {
+    // The device held the command that was acting when the loop stalled while the hand moved:
+    // that work is exact (a zero-order hold held longer) and counts in E before the chain restarts.
+    observe_energy(data.passivity, data.p_device_m);
+    restart_observer(data.passivity);
+  }
   if (data.have_position) observe_energy(data.passivity, data.p_device_m);
   update_device_faults(model, data, sample_faults);
 
@@ -146,7 +156,10 @@ TickResult tick(const RtModel& model, RtData& data, TickIo& io, const TickTiming
   Eigen::Vector3d force = Eigen::Vector3d::Zero();
   const double fade_gain = update_fade(config.proxy, data.fade, usable, model.period_s);
   if (data.have_position) {
-    data.tool = device_to_tool(config.mapping, data.p_device_m, data.v_device_m_per_s);
+    // The contact is evaluated at the sub-count position (force_position.hpp); the observer, the
+    // soft wall and the published state keep the reading.
+    data.tool = device_to_tool(config.mapping, force_position(data.force_position, data.p_device_m),
+                               data.v_device_m_per_s);
     Eigen::Vector3d new_force = Eigen::Vector3d::Zero();
     data.max_penetration_m = -1.0;
     data.patches_in_contact = 0;

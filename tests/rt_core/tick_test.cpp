@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "fissure/rt_core/faults.hpp"
+#include "fissure/rt_core/force_position.hpp"
 #include "rt_test_support.hpp"
 
 namespace fissure::rt {
@@ -128,6 +129,7 @@ TEST(Tick, ProxySwapWhileTheToolMovesKeepsTheRenderedStepWithinTheBound) {
   double previous_y_m = h.data.p_device_m.y();
   double max_step = 0.0;
   double max_motion = 0.0;
+  double force_y_m = previous_y_m;  // where the last tick evaluated the contact (force_position.hpp)
   Eigen::Vector3d p = kCentre_device_m;
   for (int i = 0; i < 200; ++i) {
     p.y() -= 20e-6;
@@ -137,6 +139,7 @@ TEST(Tick, ProxySwapWhileTheToolMovesKeepsTheRenderedStepWithinTheBound) {
     const double y = h.data.contact_force_device_n.y();
     max_step = std::max(max_step, std::fabs(y - previous));
     max_motion = std::max(max_motion, kStiffness_n_per_m * std::fabs(h.data.p_device_m.y() - previous_y_m));
+    force_y_m = h.data.p_device_m.y() - kForcePositionPreviousWeight * (h.data.p_device_m.y() - previous_y_m);
     previous = y;
     previous_y_m = h.data.p_device_m.y();
   }
@@ -144,7 +147,30 @@ TEST(Tick, ProxySwapWhileTheToolMovesKeepsTheRenderedStepWithinTheBound) {
   ASSERT_LT(max_motion, bound);    // … each within the bound by itself
   EXPECT_LE(max_step, bound + 1e-12);
   EXPECT_FALSE(blending(h.data.blend));  // and the offset did walk out meanwhile
-  EXPECT_NEAR(previous, kStiffness_n_per_m * (kNewPlaneY_m - h.data.p_device_m.y()), 1e-9);
+  EXPECT_NEAR(previous, kStiffness_n_per_m * (kNewPlaneY_m - force_y_m), 1e-9);
+}
+
+// Issue 26: across an rt stall the device held the command that was acting when the loop
+// stopped, and the hand's motion under it is work done as exactly as at any tick (a zero-order
+// hold held longer): the observer counts it before its chain restarts. Pressing 2 mm into the
+// wall under the held push, the hand paid F·Δp — the debt of the deeper contact is partly paid.
+TEST(Tick, WorkDoneUnderTheHeldForceDuringAStallIsObserved) {
+  Harness h;
+  h.settle();
+  h.publish(kStiffness_n_per_m);
+  h.step();
+  const Eigen::Vector3d held_n = h.data.passivity.force_acting_device_n;
+  ASSERT_GT(held_n.y(), 0.5);  // the wall pushes the hand out (+y)
+  const double energy_before_j = h.data.passivity.energy_j;
+  const Eigen::Vector3d p_before = h.data.p_device_m;
+  h.device.place(kCentre_device_m - Eigen::Vector3d(0.0, 0.002, 0.0));
+  h.now_ns += 100'000'000;  // 100 ms stall: far beyond the 10 ms history break
+  h.step();
+  const Eigen::Vector3d dp = h.data.p_device_m - p_before;
+  ASSERT_LT(dp.y(), -0.0015);  // the hand did press in
+  EXPECT_NEAR(h.data.passivity.energy_j, energy_before_j + held_n.dot(dp), 1e-12);
+  EXPECT_LT(h.data.passivity.energy_j, energy_before_j - 1e-3);  // > 1 mJ taken in by the held push
+  EXPECT_GT(h.data.passivity.recovery_window_left_s, 0.0);  // and the chain restarted (a history break)
 }
 
 TEST(Tick, StaleProxyFadesToZeroWithinItsBoundAndRecovers) {

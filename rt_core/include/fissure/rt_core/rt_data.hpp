@@ -7,6 +7,7 @@
 
 #include "fissure/falcon_hw/haptic_device.hpp"
 #include "fissure/shared/device_mapping.hpp"
+#include "fissure/rt_core/force_position.hpp"
 #include "fissure/rt_core/forward_kinematics_stage.hpp"
 #include "fissure/rt_core/joint_angles.hpp"
 #include "fissure/rt_core/passivity.hpp"
@@ -51,6 +52,7 @@ struct RtData {
   std::uint8_t position_epoch = 0;          ///< epoch of the position published (0: no sample accepted yet)
   bool position_continuous = false;         ///< the next accepted sample continues the published position
   // mapping, proxy, HC, blend, fade
+  ForcePositionState force_position{};      ///< the contact's sub-count position (force_position.hpp)
   ToolState tool{};
   ProxyState proxy{};
   PartForces part_forces{};
