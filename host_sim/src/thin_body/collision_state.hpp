@@ -111,6 +111,7 @@ struct CollisionData {
   std::vector<double> node_share;          // colliding node's share of its force (valid where moved_stamp == step):
                                            // 1 on the face, ramping to 0 over release_distance in front of it
   std::vector<int> candidate_nodes;
+  std::vector<Eigen::Vector3d> iterate_tool_m;  // in_solver: each candidate's position after the last projection (tool frame, current pose)
   // Node sweep (node_sweep.cpp), per tool plane: a node of it was in contact last step / the
   // current triangle may touch a node of it.
   std::vector<std::uint8_t> sweep_plane_had_contact;
@@ -195,6 +196,9 @@ void collect_force_faces(const CollisionModel& model, const StepFrame& frame, Co
 // (returns how many were moved); after the solve, every held node's share of the force from its
 // final gap, the colliding nodes listed in moved_nodes.
 int project_contacts(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft, CollisionData& data);
+// Before the first project_contacts of a step: every candidate's position after the placement,
+// from which the first iteration's moves are judged.
+void start_iterates(const StepFrame& frame, const btSoftBody& soft, CollisionData& data);
 void take_solved_shares(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data);
 // Stage 5 (hunt_crossley_force.cpp): HC per contacted triangle, summed; fills out.contacts.
 void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft,

@@ -13,10 +13,11 @@
 // project_contacts, after each iteration, on every candidate node (tool frame, current pose):
 //  * a node held on a plane this step (placed by the detection, or caught by an earlier
 //    iteration) and now behind that plane goes back on it (+ skin);
-//  * a free node the iteration pulled inside the tool volume goes out on the plane it was held
-//    on last step if that one faces a way out within a tool thickness, else on the plane its
-//    relative path start → now entered through (Cyrus–Beck), else on the nearest plane; it is
-//    held from then on. So no node ends the solve inside the tool.
+//  * a free node whose move since the last projection enters the tool (it ends inside, or it
+//    passed through a thin tool within one iteration) goes out on the plane it was held on last
+//    step if that one faces a way out within a tool thickness, else on the plane the move entered
+//    through (Cyrus–Beck), else (it started inside) on the nearest plane; it is held from then
+//    on. So no node ends the solve inside the tool or on its far side.
 // take_solved_shares, after the solve: a held node's share of the force is the smoothstep of its
 // final gap over release_distance (1 on the face, 0 at release), as the post-step hysteresis
 // ramps it; a node beyond release_distance or behind its plane is released.
@@ -42,8 +43,27 @@ void write_tool_position(const StepFrame& frame, const Eigen::Vector3d& p_tool, 
   node.m_x.setValue(static_cast<btScalar>(p_world.x()), static_cast<btScalar>(p_world.y()), static_cast<btScalar>(p_world.z()));
 }
 
+// Whether the straight move a → b (tool frame) stays outside the tool's interior, the interior
+// shrunk by the inside tolerance (Cyrus–Beck; enforced_displacement.cpp's test).
+bool segment_clears_tool(const std::vector<ToolPlane>& planes, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  double t_enter = 0.0;
+  double t_exit = 1.0;
+  for (const ToolPlane& plane : planes) {
+    const double fa = plane.normal_tool.dot(a) - plane.offset_m + kInsideTolerance_m;
+    const double fb = plane.normal_tool.dot(b) - plane.offset_m + kInsideTolerance_m;
+    if (fa >= 0.0 && fb >= 0.0) return true;
+    if (fa >= 0.0) {
+      t_enter = std::max(t_enter, fa / (fa - fb));
+    } else if (fb >= 0.0) {
+      t_exit = std::min(t_exit, fa / (fa - fb));
+    }
+    if (t_enter >= t_exit) return true;
+  }
+  return false;
+}
+
 // The plane a free node found inside the tool leaves by (see the file comment for the order).
-int exit_plane(const CollisionModel& model, const StepFrame& frame, const CollisionData& data, int node,
+int exit_plane(const CollisionModel& model, const StepFrame& frame, const CollisionData& data, int node, const Eigen::Vector3d& a,
                const Eigen::Vector3d& p_tool) {
   const auto& planes = model.tool.planes();
   const auto n = static_cast<std::size_t>(node);
@@ -52,7 +72,6 @@ int exit_plane(const CollisionModel& model, const StepFrame& frame, const Collis
     const ToolPlane& held = planes[static_cast<std::size_t>(data.hold_plane[n])];
     if (held.offset_m - held.normal_tool.dot(p_tool) <= reach_m) return data.hold_plane[n];
   }
-  const Eigen::Vector3d& a = data.start_tool_m[n];
   double t_enter = 0.0;
   int enter_plane = -1;
   int nearest_plane = 0;
@@ -72,14 +91,14 @@ int exit_plane(const CollisionModel& model, const StepFrame& frame, const Collis
       }
     }
   }
-  if (enter_plane >= 0) {
-    const ToolPlane& entered = planes[static_cast<std::size_t>(enter_plane)];
-    if (entered.offset_m - entered.normal_tool.dot(p_tool) <= reach_m) return enter_plane;
-  }
-  return nearest_plane;
+  return enter_plane >= 0 ? enter_plane : nearest_plane;
 }
 
 }  // namespace
+
+void start_iterates(const StepFrame& frame, const btSoftBody& soft, CollisionData& data) {
+  for (const int node : data.candidate_nodes) data.iterate_tool_m[static_cast<std::size_t>(node)] = to_tool(frame, soft.m_nodes[node].m_x);
+}
 
 int project_contacts(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft, CollisionData& data) {
   const auto& planes = model.tool.planes();
@@ -93,19 +112,28 @@ int project_contacts(const CollisionModel& model, const StepFrame& frame, btSoft
     int plane_index = -1;
     if (data.hold_stamp[n] == frame.step) {
       const ToolPlane& held = planes[static_cast<std::size_t>(data.hold_plane[n])];
-      if (held.normal_tool.dot(p) >= held.offset_m + skin_m) continue;
+      if (held.normal_tool.dot(p) >= held.offset_m + skin_m) {
+        data.iterate_tool_m[n] = p;
+        continue;
+      }
       plane_index = data.hold_plane[n];
     } else {
-      double depth_m = -std::numeric_limits<double>::infinity();  // signed distance to the tool, < 0 inside
-      for (const ToolPlane& plane : planes) depth_m = std::max(depth_m, plane.normal_tool.dot(p) - plane.offset_m);
-      if (depth_m >= -kInsideTolerance_m) continue;
-      plane_index = exit_plane(model, frame, data, node, p);
+      // Inside the tool now, or passed through it since the last projection (an iteration moves
+      // a node by up to a link's correction, more than a 1 mm blade is thick): out through the
+      // face it entered by on that move.
+      const Eigen::Vector3d& a = data.iterate_tool_m[n];
+      if (segment_clears_tool(planes, a, p)) {
+        data.iterate_tool_m[n] = p;
+        continue;
+      }
+      plane_index = exit_plane(model, frame, data, node, a, p);
       data.hold_stamp[n] = frame.step;
       data.hold_plane[n] = plane_index;
     }
     const ToolPlane& plane = planes[static_cast<std::size_t>(plane_index)];
     p += (plane.offset_m + skin_m - plane.normal_tool.dot(p)) * plane.normal_tool;
     write_tool_position(frame, p, soft_node);
+    data.iterate_tool_m[n] = p;
     ++projected;
   }
   return projected;
