@@ -1,5 +1,6 @@
 // Closed-surface shape checks (mesh_checks.hpp).
 #include "fissure/host_sim/mesh_checks.hpp"
+#include "mesh_detail.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -26,13 +27,7 @@ std::string metres(double value) {
   return out.str();
 }
 
-int find_root(std::vector<int>& parent, int i) {
-  while (parent[static_cast<std::size_t>(i)] != i) {
-    parent[static_cast<std::size_t>(i)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
-    i = parent[static_cast<std::size_t>(i)];
-  }
-  return i;
-}
+using mesh_detail::find_root;
 
 }  // namespace
 

@@ -1,5 +1,6 @@
 // OBJ / STL mesh files (mesh_file.hpp).
 #include "fissure/host_sim/mesh_file.hpp"
+#include "mesh_detail.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -224,11 +225,7 @@ MeshFile read_stl_binary(const std::string& path, const std::string& bytes, std:
   return mesh;
 }
 
-std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
+using mesh_detail::lower_extension;
 
 }  // namespace
 

@@ -1,5 +1,6 @@
 // Tetrahedral mesh clean-up, boundary and checks (tet_mesh_checks.hpp).
 #include "fissure/host_sim/tet_mesh_checks.hpp"
+#include "mesh_detail.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -33,13 +34,7 @@ double volume6_m3(const TetMesh& mesh, const std::array<int, 4>& t) {
       .dot((e3(mesh.vertices_m[static_cast<std::size_t>(t[2])]) - a).cross(e3(mesh.vertices_m[static_cast<std::size_t>(t[3])]) - a));
 }
 
-int find_root(std::vector<int>& parent, int i) {
-  while (parent[static_cast<std::size_t>(i)] != i) {
-    parent[static_cast<std::size_t>(i)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
-    i = parent[static_cast<std::size_t>(i)];
-  }
-  return i;
-}
+using mesh_detail::find_root;
 
 }  // namespace
 

@@ -3,6 +3,7 @@
 // global model per process; VTK: hundreds of MB of headers) and none reads all three; each
 // format here is a few whitespace-separated sections, read token by token with their lines.
 #include "fissure/host_sim/tet_mesh_file.hpp"
+#include "mesh_detail.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -518,11 +519,7 @@ TetMesh read_tetgen(const std::string& path, std::size_t max_tetrahedra) {
   return mesh;
 }
 
-std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
+using mesh_detail::lower_extension;
 
 }  // namespace
 
