@@ -184,6 +184,10 @@ struct DisplacementCounts {
 // broad phase later in the same step still reads conservative bounds.
 DisplacementCounts enforce_displacement(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft,
                                         CollisionData& data, SoftNodeBounds* node_bounds = nullptr);
+// Whether the straight segment a → b (tool frame) stays outside the tool's interior (Cyrus–Beck
+// clip against every tool plane; the interior shrunk by the inside tolerance, so touching a face
+// or an edge is not "through").
+bool segment_clears_tool(const std::vector<ToolPlane>& planes, const Eigen::Vector3d& a, const Eigen::Vector3d& b);
 // enforce_displacement's three parts: place the contacted nodes (and guard), keep last step's held
 // nodes within release_distance colliding (after_step's hysteresis), and collect the force set
 // (every face around a colliding node) into contacted_faces.

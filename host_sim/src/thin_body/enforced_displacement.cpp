@@ -75,26 +75,6 @@ struct Writer {
     return true;
   }
 
-  // Whether the straight segment a → b (tool frame) stays outside the tool's interior (Cyrus–Beck
-  // clip against every tool plane; the interior shrunk by the inside tolerance, so touching a
-  // face or an edge is not "through").
-  bool segment_clears_tool(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
-    double t_enter = 0.0;
-    double t_exit = 1.0;
-    for (const ToolPlane& plane : model.tool.planes()) {
-      const double fa = plane.normal_tool.dot(a) - plane.offset_m + kInsideTolerance_m;
-      const double fb = plane.normal_tool.dot(b) - plane.offset_m + kInsideTolerance_m;
-      if (fa >= 0.0 && fb >= 0.0) return true;  // the whole segment is outside this plane
-      if (fa >= 0.0) {
-        t_enter = std::max(t_enter, fa / (fa - fb));
-      } else if (fb >= 0.0) {
-        t_exit = std::min(t_exit, fa / (fa - fb));
-      }
-      if (t_enter >= t_exit) return true;
-    }
-    return false;
-  }
-
   void write(int node, int plane_index) {
     const auto n = static_cast<std::size_t>(node);
     const Eigen::Vector3d p_world = frame.r_cur * data.end_tool_m[n] + frame.t_cur;
@@ -130,7 +110,7 @@ struct Writer {
     const ToolPlane& target_plane = model.tool.planes()[static_cast<std::size_t>(plane_index)];
     const Eigen::Vector3d& a = data.end_tool_m[static_cast<std::size_t>(node)];
     if (target_plane.normal_tool.dot(a) >= target_plane.offset_m + model.params.skin_m) return true;  // in front: nothing to move
-    return segment_clears_tool(a, target_on_plane(node, plane_index));
+    return segment_clears_tool(model.tool.planes(), a, target_on_plane(node, plane_index));
   }
 
   void paired_faces() {
@@ -218,6 +198,23 @@ struct Writer {
 };
 
 }  // namespace
+
+bool segment_clears_tool(const std::vector<ToolPlane>& planes, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  double t_enter = 0.0;
+  double t_exit = 1.0;
+  for (const ToolPlane& plane : planes) {
+    const double fa = plane.normal_tool.dot(a) - plane.offset_m + kInsideTolerance_m;
+    const double fb = plane.normal_tool.dot(b) - plane.offset_m + kInsideTolerance_m;
+    if (fa >= 0.0 && fb >= 0.0) return true;  // the whole segment is outside this plane
+    if (fa >= 0.0) {
+      t_enter = std::max(t_enter, fa / (fa - fb));
+    } else if (fb >= 0.0) {
+      t_exit = std::min(t_exit, fa / (fa - fb));
+    }
+    if (t_enter >= t_exit) return true;
+  }
+  return false;
+}
 
 DisplacementCounts place_contact_nodes(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft, CollisionData& data,
                                        SoftNodeBounds* node_bounds) {

@@ -43,25 +43,6 @@ void write_tool_position(const StepFrame& frame, const Eigen::Vector3d& p_tool, 
   node.m_x.setValue(static_cast<btScalar>(p_world.x()), static_cast<btScalar>(p_world.y()), static_cast<btScalar>(p_world.z()));
 }
 
-// Whether the straight move a → b (tool frame) stays outside the tool's interior, the interior
-// shrunk by the inside tolerance (Cyrus–Beck; enforced_displacement.cpp's test).
-bool segment_clears_tool(const std::vector<ToolPlane>& planes, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  double t_enter = 0.0;
-  double t_exit = 1.0;
-  for (const ToolPlane& plane : planes) {
-    const double fa = plane.normal_tool.dot(a) - plane.offset_m + kInsideTolerance_m;
-    const double fb = plane.normal_tool.dot(b) - plane.offset_m + kInsideTolerance_m;
-    if (fa >= 0.0 && fb >= 0.0) return true;
-    if (fa >= 0.0) {
-      t_enter = std::max(t_enter, fa / (fa - fb));
-    } else if (fb >= 0.0) {
-      t_exit = std::min(t_exit, fa / (fa - fb));
-    }
-    if (t_enter >= t_exit) return true;
-  }
-  return false;
-}
-
 // The plane a free node found inside the tool leaves by (see the file comment for the order).
 int exit_plane(const CollisionModel& model, const StepFrame& frame, const CollisionData& data, int node, const Eigen::Vector3d& a,
                const Eigen::Vector3d& p_tool) {
