@@ -20,9 +20,7 @@ ThinBodyCollision::~ThinBodyCollision() = default;
 namespace {
 
 using Clock = std::chrono::steady_clock;
-// A node counts as inside the tool beyond this depth (float noise of positions written at +skin;
-// enforced_displacement.cpp's tolerance).
-constexpr double kInsideTolerance_m = 1e-7;
+using thin_body::kInsideTolerance_m;
 double seconds_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
 // What the detection stages (1–4: broad phase, node sweep, pair exclusion, placement) found in a

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -15,6 +16,16 @@
 class btSoftBody;
 
 namespace fissure::host::thin_body {
+
+// A node counts as inside the tool only beyond this depth (float noise of positions written at +skin).
+inline constexpr double kInsideTolerance_m = 1e-7;
+
+// A held node's share of its force at `gap_m` in front of its plane: smoothstep from 1 on the
+// face to 0 at `release_m`, flat at both ends, so a node fades out as it separates.
+inline double release_share(double gap_m, double release_m) {
+  const double u = release_m > 0.0 ? std::max(0.0, gap_m) / release_m : 0.0;
+  return 1.0 - u * u * (3.0 - 2.0 * u);
+}
 
 // Topology and rest state of the soft surface (paper: "during the object initialization, the
 // original position of each triangle vertices is stored").

@@ -37,8 +37,6 @@
 namespace fissure::host::thin_body {
 namespace {
 
-// A node counts as inside the tool only beyond this depth (float noise of positions written at +skin).
-constexpr double kInsideTolerance_m = 1e-7;
 // Two tool planes "face the same way" (a node held on one may be moved to the other) above this cosine.
 constexpr double kSameSideCosine = 0.5;
 // A rim node "leads into" a soft triangle when it meets it within 60° of head-on (tool normal ·
@@ -249,8 +247,7 @@ void hold_near_nodes(const CollisionModel& model, const StepFrame& frame, Collis
     const double gap = plane.normal_tool.dot(data.end_tool_m[n]) - plane.offset_m;
     if (gap > release_m) continue;  // separated: released
     if (gap < 0.0) continue;  // pushed behind its plane with no tool node hitting it: released
-    const double u = release_m > 0.0 ? gap / release_m : 0.0;
-    data.node_share[n] = 1.0 - u * u * (3.0 - 2.0 * u);  // smoothstep: flat at the face and at the release
+    data.node_share[n] = release_share(gap, release_m);
     data.hold_stamp[n] = frame.step;  // lifted off the face it moves freely (only its side is remembered)
     data.moved_stamp[n] = frame.step;
     data.moved_nodes.push_back(node);

@@ -30,10 +30,6 @@
 namespace fissure::host::thin_body {
 namespace {
 
-// A node counts as inside the tool only beyond this depth (float noise of positions written at
-// +skin; enforced_displacement.cpp's tolerance).
-constexpr double kInsideTolerance_m = 1e-7;
-
 Eigen::Vector3d to_tool(const StepFrame& frame, const btVector3& x_world) {
   return frame.r_cur.transpose() * (Eigen::Vector3d(x_world.x(), x_world.y(), x_world.z()) - frame.t_cur);
 }
@@ -141,8 +137,7 @@ void take_solved_shares(const CollisionModel& model, const StepFrame& frame, con
       if (data.moved_stamp[n] == frame.step) data.moved_stamp[n] = frame.step - 1;
       continue;
     }
-    const double u = release_m > 0.0 ? std::max(0.0, gap_m) / release_m : 0.0;
-    data.node_share[n] = 1.0 - u * u * (3.0 - 2.0 * u);  // smoothstep: flat on the face and at the release
+    data.node_share[n] = release_share(gap_m, release_m);
     data.hold_stamp[n] = frame.step;
     data.moved_stamp[n] = frame.step;
     data.moved_nodes.push_back(node);
