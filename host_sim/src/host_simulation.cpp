@@ -80,6 +80,8 @@ HostSimulation::HostSimulation(const SceneDescription& scene, std::optional<Scen
     ThinBodyCollisionParams params;
     params.hunt_crossley = scene_.hunt_crossley;
     params.response = scene_.simulation.contact_response;
+    params.friction_static_ratio = scene_.tool.friction_static_ratio;
+    params.friction_kinetic_ratio = scene_.tool.friction_kinetic_ratio;
     for (int p = 0; p < parts; ++p) {
       params.jaw = p;
       const ToolNodes& nodes = tool_nodes_[static_cast<std::size_t>(p)];

@@ -255,6 +255,13 @@ void read_tool(const std::string& file, TableReader& t, ToolDescription& tool, c
   } else {
     tool.node_spacing_m = t.positive("node_spacing", "m");
   }
+  // Coulomb ratios above 2 are not a tool on wet tissue (steel on soft tissue measures 0.1–0.5;
+  // docs/scenes.md); kinetic above static would make sliding grip harder than sticking.
+  tool.friction_static_ratio = t.in_range("friction_static", "ratio", 0.0, 2.0, 0.0);
+  tool.friction_kinetic_ratio = t.in_range("friction_kinetic", "ratio", 0.0, 2.0, tool.friction_static_ratio);
+  if (tool.friction_kinetic_ratio > tool.friction_static_ratio)
+    t.fail(t.line_for("friction_kinetic", "ratio"), "friction_kinetic_ratio",
+           "must be <= friction_static_ratio (" + config::format_number(tool.friction_static_ratio) + ")");
   t.finish();
 }
 
@@ -345,6 +352,11 @@ SceneDescription parse(const toml::table& root, const std::string& file, const s
     read_trajectory(file, t, scene.trajectory, scene.tool.kind == ToolKind::kClamp);
   }
   top.finish();
+  if (scene.tool.friction_static_ratio > 0.0 && scene.simulation.contact_response != ContactResponse::kInSolver) {
+    const toml::node* key = root["tool"]["friction_static_ratio"].node();
+    throw SceneError(file, key != nullptr ? line_of(*key) : 1, "tool.friction_static_ratio",
+                     "friction is solved inside the soft-body solver: it needs [simulation] contact_response = \"in_solver\"");
+  }
   if (scene.tool.kind == ToolKind::kClamp && !scene.device_mapping.clamp_mode) {
     const toml::node* flag = root["device_mapping"]["clamp_mode"].node();
     throw SceneError(file, flag != nullptr ? line_of(*flag) : 1, "device_mapping.clamp_mode",

@@ -104,7 +104,7 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision, public SoftContact
     if (!pending_ || &soft != soft_) return;  // a step nobody prepared: the body is solved without this contact
     pending_ = false;
     detect_and_place(pending_previous_, pending_current_, pending_dt_s_, soft);
-    if (report_.broad_phase_hit) thin_body::start_iterates(frame_, soft, data_);
+    if (report_.broad_phase_hit) thin_body::start_iterates(model_, frame_, soft, data_);
     solved_ = true;
   }
 

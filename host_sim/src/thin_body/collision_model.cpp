@@ -158,6 +158,9 @@ void allocate_collision_data(const CollisionModel& model, CollisionData& data) {
   data.hold_plane.assign(soft_nodes, -1);
   data.node_share.assign(soft_nodes, 0.0);
   data.iterate_tool_m.assign(soft_nodes, Eigen::Vector3d::Zero());
+  data.friction_anchor_tool_m.assign(soft_nodes, Eigen::Vector3d::Zero());
+  data.friction_anchor_stamp.assign(soft_nodes, -1);
+  data.normal_push_m.assign(soft_nodes, 0.0);
   data.candidate_nodes.clear();
   data.candidate_nodes.reserve(soft_nodes);
   data.sweep_plane_had_contact.assign(model.tool.planes().size(), 0);

@@ -123,6 +123,12 @@ struct CollisionData {
                                            // 1 on the face, ramping to 0 over release_distance in front of it
   std::vector<int> candidate_nodes;
   std::vector<Eigen::Vector3d> iterate_tool_m;  // in_solver: each candidate's position after the last projection (tool frame, current pose)
+  // In-solver friction: where a held node sticks (tool frame; the node's position at the end of
+  // the step it was last held, or where it was first held this step), valid at friction_anchor_stamp,
+  // and the normal correction the contact applied to it this step (m, ≥ 0).
+  std::vector<Eigen::Vector3d> friction_anchor_tool_m;
+  std::vector<std::int64_t> friction_anchor_stamp;
+  std::vector<double> normal_push_m;
   // Node sweep (node_sweep.cpp), per tool plane: a node of it was in contact last step / the
   // current triangle may touch a node of it.
   std::vector<std::uint8_t> sweep_plane_had_contact;
@@ -213,7 +219,7 @@ void collect_force_faces(const CollisionModel& model, const StepFrame& frame, Co
 int project_contacts(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft, CollisionData& data);
 // Before the first project_contacts of a step: every candidate's position after the placement,
 // from which the first iteration's moves are judged.
-void start_iterates(const StepFrame& frame, const btSoftBody& soft, CollisionData& data);
+void start_iterates(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data);
 void take_solved_shares(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data);
 // Stage 5 (hunt_crossley_force.cpp): HC per contacted triangle, summed; fills out.contacts.
 void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft,

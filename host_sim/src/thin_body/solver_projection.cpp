@@ -25,6 +25,7 @@
 
 #include <BulletSoftBody/btSoftBody.h>
 
+#include <algorithm>
 #include <limits>
 
 namespace fissure::host::thin_body {
@@ -73,13 +74,31 @@ int exit_plane(const CollisionModel& model, const StepFrame& frame, const Collis
 
 }  // namespace
 
-void start_iterates(const StepFrame& frame, const btSoftBody& soft, CollisionData& data) {
-  for (const int node : data.candidate_nodes) data.iterate_tool_m[static_cast<std::size_t>(node)] = to_tool(frame, soft.m_nodes[node].m_x);
+void start_iterates(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data) {
+  const auto& planes = model.tool.planes();
+  for (const int node : data.candidate_nodes) {
+    const auto n = static_cast<std::size_t>(node);
+    const Eigen::Vector3d p = to_tool(frame, soft.m_nodes[node].m_x);
+    data.iterate_tool_m[n] = p;
+    data.normal_push_m[n] = 0.0;
+    if (data.hold_stamp[n] != frame.step) continue;
+    // Placed by the detection: the placement's move along the face normal (from the prediction,
+    // end_tool_m) is this step's first normal correction, and a node not held last step sticks
+    // where it was placed.
+    const ToolPlane& plane = planes[static_cast<std::size_t>(data.hold_plane[n])];
+    data.normal_push_m[n] = std::max(0.0, plane.normal_tool.dot(p - data.end_tool_m[n]));
+    if (data.friction_anchor_stamp[n] != frame.step - 1) {
+      data.friction_anchor_tool_m[n] = p;
+      data.friction_anchor_stamp[n] = frame.step;
+    }
+  }
 }
 
 int project_contacts(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft, CollisionData& data) {
   const auto& planes = model.tool.planes();
   const double skin_m = model.params.skin_m;
+  const double mu_static = model.params.friction_static_ratio;
+  const double mu_kinetic = model.params.friction_kinetic_ratio;
   int projected = 0;
   for (const int node : data.candidate_nodes) {
     btSoftBody::Node& soft_node = soft.m_nodes[node];
@@ -88,11 +107,6 @@ int project_contacts(const CollisionModel& model, const StepFrame& frame, btSoft
     Eigen::Vector3d p = to_tool(frame, soft_node.m_x);
     int plane_index = -1;
     if (data.hold_stamp[n] == frame.step) {
-      const ToolPlane& held = planes[static_cast<std::size_t>(data.hold_plane[n])];
-      if (held.normal_tool.dot(p) >= held.offset_m + skin_m) {
-        data.iterate_tool_m[n] = p;
-        continue;
-      }
       plane_index = data.hold_plane[n];
     } else {
       // Inside the tool now, or passed through it since the last projection (an iteration moves
@@ -108,9 +122,33 @@ int project_contacts(const CollisionModel& model, const StepFrame& frame, btSoft
       data.hold_plane[n] = plane_index;
     }
     const ToolPlane& plane = planes[static_cast<std::size_t>(plane_index)];
-    p += (plane.offset_m + skin_m - plane.normal_tool.dot(p)) * plane.normal_tool;
-    write_tool_position(frame, p, soft_node);
+    const double push_m = plane.offset_m + skin_m - plane.normal_tool.dot(p);
+    bool moved = false;
+    if (push_m > 0.0) {
+      p += push_m * plane.normal_tool;
+      data.normal_push_m[n] += push_m;
+      moved = true;
+    }
+    if (data.friction_anchor_stamp[n] < frame.step - 1) {
+      // Caught by this iteration: it sticks where it was put out.
+      data.friction_anchor_tool_m[n] = p;
+      data.friction_anchor_stamp[n] = frame.step;
+    }
+    if (mu_static > 0.0 && data.normal_push_m[n] > 0.0) {
+      // Coulomb at position level: the tangential move since the anchor against the cone of this
+      // step's normal correction.
+      Eigen::Vector3d slip = p - data.friction_anchor_tool_m[n];
+      slip -= plane.normal_tool.dot(slip) * plane.normal_tool;
+      const double slip_m = slip.norm();
+      if (slip_m > 0.0) {
+        const double stick_limit_m = mu_static * data.normal_push_m[n];
+        p -= slip_m <= stick_limit_m ? slip : slip * std::min(1.0, mu_kinetic * data.normal_push_m[n] / slip_m);
+        moved = true;
+      }
+    }
     data.iterate_tool_m[n] = p;
+    if (!moved) continue;
+    write_tool_position(frame, p, soft_node);
     ++projected;
   }
   return projected;
@@ -138,6 +176,8 @@ void take_solved_shares(const CollisionModel& model, const StepFrame& frame, con
       continue;
     }
     data.node_share[n] = release_share(gap_m, release_m);
+    data.friction_anchor_tool_m[n] = p;
+    data.friction_anchor_stamp[n] = frame.step;
     data.hold_stamp[n] = frame.step;
     data.moved_stamp[n] = frame.step;
     data.moved_nodes.push_back(node);

@@ -146,6 +146,11 @@ struct ToolDescription {
   ClampDescription clamp{};
   double node_spacing_m = 0.004;           ///< box / clamp jaws: collision node grid spacing on the large faces
   double pairing_ray_limit_m = 0.006;      ///< convex mesh: the pairing ray's length limit (paper Fig. 2); node per triangle
+  /// Coulomb friction between the tool's faces and the tissue (in_solver response only): a held
+  /// node sticks while its tangential correction stays within static × its normal correction,
+  /// else slides against kinetic × it. 0 / 0: frictionless (the paper's contact).
+  double friction_static_ratio = 0.0;
+  double friction_kinetic_ratio = 0.0;
 };
 
 // What the Hunt-Crossley deformation x of a contacted triangle measures (docs/scenes.md,

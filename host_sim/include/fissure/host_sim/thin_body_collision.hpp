@@ -56,6 +56,13 @@ struct ThinBodyCollisionParams {
   // is projected out of it. 1 mm: a link pulls a node at most its share of the held nodes'
   // displacement in one step; the hold-and-sweep tests check no node ends inside.
   double solver_reach_m = 1.0e-3;
+  // In-solver: Coulomb friction of a held node on its tool face, at position level (Macklin et al.
+  // 2014, "Unified particle physics", §6.1): within one step a node's tangential move relative to
+  // the tool is undone while it is at most static × the normal correction the contact applied to
+  // it this step (both are impulse × h / m, so their ratio is the force ratio), else shortened by
+  // kinetic × that normal correction. 0: frictionless.
+  double friction_static_ratio = 0.0;
+  double friction_kinetic_ratio = 0.0;
 };
 
 // One contacted soft triangle (what the proxy builder needs: a plane per contact, which tool face
