@@ -71,6 +71,13 @@ SceneDescription with_response(SceneDescription scene, host::ContactResponse res
   return scene;
 }
 
+// A plunge cell's scene: in_solver runs the tests' in-solver cells (tool friction, ball on its
+// bed: host::in_solver_plunge_scene).
+SceneDescription plunge_cell_scene(const host::PlungeTool& tool, int icosphere_faces, host::ContactResponse response) {
+  const SceneDescription scene = host::plunge_scene(tool, icosphere_faces);
+  return response == host::ContactResponse::kInSolver ? host::in_solver_plunge_scene(scene) : with_response(scene, response);
+}
+
 // Least-squares slope of log F against log d (points with F > 0).
 double fitted_exponent(const std::vector<std::pair<double, double>>& curve) {
   double sx = 0, sy = 0, sxx = 0, sxy = 0;
@@ -157,7 +164,7 @@ nlohmann::json sweep_cells(const std::vector<double>& speeds, const std::vector<
   SimProgress progress(progress_name, static_cast<long>(speeds.size() * tools.size() * methods.size()));
   long done = 0;
   for (const host::PlungeTool& tool : tools) {
-    const SceneDescription scene = with_response(host::plunge_scene(tool, icosphere_faces), response);
+    const SceneDescription scene = plunge_cell_scene(tool, icosphere_faces, response);
     const std::string tool_name(tool.name);
     for (SceneCollisionMethod method : methods) {
       for (double v : speeds) {
@@ -219,7 +226,7 @@ void run_motion_cells(const BenchCollisionOptions& o, nlohmann::json& out) {
               "F_hold N", "jitter%", "step%");
   nlohmann::json lever = nlohmann::json::array();
   for (const int faces : {0, kFineSweepFaces}) {
-    const SceneDescription scene = with_response(host::plunge_scene(host::plunge_tools()[2], faces), o.contact_response);
+    const SceneDescription scene = plunge_cell_scene(host::plunge_tools()[2], faces, o.contact_response);
     for (SceneCollisionMethod method : {SceneCollisionMethod::kBullet, SceneCollisionMethod::kPaired}) {
       const host::LeverResult r = host::run_lever_hold(scene, method, hold_s);
       const int mesh = faces == 0 ? 128 : faces;

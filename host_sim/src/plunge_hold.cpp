@@ -38,6 +38,17 @@ SceneDescription plunge_scene(const PlungeTool& tool, int icosphere_faces) {
   return s;
 }
 
+SceneDescription in_solver_plunge_scene(SceneDescription scene) {
+  scene.simulation.contact_response = ContactResponse::kInSolver;
+  scene.tool.friction_static_ratio = kPlungeFrictionStaticRatio;
+  scene.tool.friction_kinetic_ratio = kPlungeFrictionKineticRatio;
+  SoftAnchorBox bed;
+  bed.min_world_m = {-1.0, scene.ground.top_height_m - 1.0, -1.0};
+  bed.max_world_m = {1.0, scene.ground.top_height_m + kPlungeBedTop_m, 1.0};
+  scene.soft_body.anchors.push_back(bed);
+  return scene;
+}
+
 HoldForceStats hold_force_stats(const std::vector<double>& force_n) {
   HoldForceStats stats;
   if (force_n.empty()) return stats;

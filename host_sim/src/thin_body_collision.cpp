@@ -21,6 +21,10 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 using thin_body::kInsideTolerance_m;
+// Rim and node projections alternate this many times after each of Bullet's position iterations:
+// each undoes a little of the other (a rim move can push a held node into a face, a node move can
+// let a triangle sag back over the rim), and alternating projections converge on what both allow.
+constexpr int kProjectionPasses = 2;
 double seconds_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
 // What the detection stages (1–4: broad phase, node sweep, pair exclusion, placement) found in a
@@ -111,7 +115,10 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision, public SoftContact
   void project(btSoftBody& soft) override {
     if (!solved_ || !report_.broad_phase_hit || &soft != soft_) return;
     const Clock::time_point t0 = Clock::now();
-    report_.guard_corrections += thin_body::project_contacts(model_, frame_, soft, data_);
+    for (int pass = 0; pass < kProjectionPasses; ++pass) {
+      report_.guard_corrections += thin_body::project_rim_contacts(model_, frame_, soft, data_);
+      report_.guard_corrections += thin_body::project_contacts(model_, frame_, soft, data_);
+    }
     report_.seconds_response += seconds_between(t0, Clock::now());
   }
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -126,6 +127,14 @@ ToolNodes ToolNodes::from_box(const BoxToolShape& shape) {
     tool.hull_vertices_tool_m_.emplace_back((corner & 1) ? h.x() : -h.x(), (corner & 2) ? h.y() : -h.y(),
                                             (corner & 4) ? h.z() : -h.z());
   }
+  // The 12 box edges: corner pairs differing in one coordinate bit.
+  for (int corner = 0; corner < 8; ++corner) {
+    for (int bit = 1; bit < 8; bit <<= 1) {
+      if ((corner & bit) != 0) continue;
+      tool.feature_edges_tool_m_.push_back({tool.hull_vertices_tool_m_[static_cast<std::size_t>(corner)],
+                                            tool.hull_vertices_tool_m_[static_cast<std::size_t>(corner | bit)]});
+    }
+  }
   tool.thin_axis_ = w;
   tool.thickness_m_ = 2.0 * h[w];
   tool.finish_pairing();
@@ -238,6 +247,24 @@ ToolNodes ToolNodes::from_convex_mesh(const ConvexMeshToolShape& shape) {
     }
   }
   tool.hull_vertices_tool_m_ = verts;
+  // Feature edges: a triangle edge whose two triangles lie on different planes (one hash lookup
+  // per triangle edge: linear in the mesh).
+  {
+    struct EdgeHash {
+      std::size_t operator()(std::uint64_t key) const noexcept { return std::hash<std::uint64_t>{}(key * 0x9E3779B97F4A7C15ULL); }
+    };
+    std::unordered_map<std::uint64_t, int, EdgeHash> first_plane_of_edge;
+    first_plane_of_edge.reserve(3 * shape.triangles.size());
+    for (std::size_t f = 0; f < shape.triangles.size(); ++f) {
+      for (int k = 0; k < 3; ++k) {
+        const auto a = static_cast<std::uint32_t>(shape.triangles[f][static_cast<std::size_t>(k)]);
+        const auto b = static_cast<std::uint32_t>(shape.triangles[f][static_cast<std::size_t>((k + 1) % 3)]);
+        const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
+        const auto [it, inserted] = first_plane_of_edge.emplace(key, tool.plane_of_node_[f]);
+        if (!inserted && it->second != tool.plane_of_node_[f]) tool.feature_edges_tool_m_.push_back({verts[a], verts[b]});
+      }
+    }
+  }
   const Eigen::Vector3d extent = tool.bounds_tool_m_.sizes();
   extent.minCoeff(&tool.thin_axis_);
   tool.thickness_m_ = extent[tool.thin_axis_];

@@ -82,18 +82,17 @@ TEST(ClampReleaseCell, DISABLED_OpeningReleasesTheBallAfterAnySettlingTime) {
 }
 
 // In-solver response (issue 22, contact_response = "in_solver", experimental): the levering blade
-// on the paper's 128-face ball and on a 1280-face one keeps the paired guarantees, and the opened
-// clamp lets go after every settling time. NOT MET (disabled so that they stay visible; figures
-// in docs/decisions.md, "Contact inside the solver", 2026-12-04): the 128-face lever loses the
-// ball (0 N held), and the opened clamp keeps 11.6–12.8 N (soft nodes wrapped round the jaw tips).
+// (the in-solver cells' scene, host::in_solver_plunge_scene) on the paper's 128-face ball and on a
+// 1280-face one keeps the paired guarantees and cuts no soft triangle on any step, and the opened
+// clamp lets go after every settling time, cutting none either.
 SceneDescription in_solver(SceneDescription scene) {
   scene.simulation.contact_response = ContactResponse::kInSolver;
   return scene;
 }
 
-TEST(LeverCell, DISABLED_InSolverCrossesNoNodeAndKeepsContactThroughTheTurn) {
+TEST(LeverCell, InSolverCrossesNoNodeCutsNoTriangleAndKeepsContactThroughTheTurn) {
   for (const int faces : {128, 1280}) {
-    const SceneDescription scene = in_solver(plunge_scene(plunge_tools()[2], faces == 128 ? 0 : faces));
+    const SceneDescription scene = in_solver_plunge_scene(plunge_scene(plunge_tools()[2], faces == 128 ? 0 : faces));
     const LeverResult r = run_lever_hold(scene, SceneCollisionMethod::kPaired, kHoldS);
     std::printf("[lever] %d faces, paired in_solver: crossed %d, inside %d, penetration %.4f mm, cut max %d on %d of %d steps, "
                 "F_hold %.3f N, jitter %.3f %%, step noise %.3f %%\n",
@@ -103,10 +102,11 @@ TEST(LeverCell, DISABLED_InSolverCrossesNoNodeAndKeepsContactThroughTheTurn) {
     EXPECT_LE(r.max_penetration_m, kMaxPenetrationM) << faces;
     EXPECT_TRUE(std::isfinite(r.hold.mean_n)) << faces;
     EXPECT_GT(r.hold.mean_n, 0.0) << faces << " faces: the turned blade lost the ball";
+    EXPECT_EQ(r.max_cut_triangles, 0) << faces << " faces";
   }
 }
 
-TEST(ClampReleaseCell, DISABLED_InSolverOpeningReleasesTheBallAfterAnySettlingTime) {
+TEST(ClampReleaseCell, InSolverOpeningReleasesTheBallAfterAnySettlingTime) {
   const SceneDescription scene = in_solver(load_scene(resolve_scene_path("clamp-sphere")));
   for (const double settle_s : {0.1, 0.2, 0.3, 0.5}) {
     const ClampReleaseResult c = run_clamp_release(scene, SceneCollisionMethod::kPaired, settle_s);
@@ -116,6 +116,7 @@ TEST(ClampReleaseCell, DISABLED_InSolverOpeningReleasesTheBallAfterAnySettlingTi
     EXPECT_GT(c.open_steps, kClampOpenGraceSteps) << "settled " << settle_s << " s";
     EXPECT_LT(c.open_force_max_n, kOpenForceMaxN) << "settled " << settle_s << " s";
     EXPECT_EQ(c.crossed_nodes, 0) << "settled " << settle_s << " s";
+    EXPECT_EQ(c.max_cut_triangles, 0) << "settled " << settle_s << " s";
   }
 }
 

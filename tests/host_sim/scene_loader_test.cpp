@@ -163,6 +163,29 @@ TEST(SceneLoader, ContactResponseIsOptionalAndChecked) {
   EXPECT_EQ(parse_contact_response("In_Solver"), std::nullopt);
 }
 
+// [tool] friction_static_ratio / friction_kinetic_ratio: optional (0: frictionless), kinetic
+// defaults to static, each in [0, 2], kinetic ≤ static, and only with the in-solver response (the
+// friction is solved in its iterations).
+TEST(SceneLoader, ToolFrictionIsOptionalCheckedAndNeedsTheInSolverResponse) {
+  const std::string good = read(kScenes / "spatula-sphere.toml");
+  const SceneDescription plain = load_scene_text(good, "good.toml", kScenes);
+  EXPECT_EQ(plain.tool.friction_static_ratio, 0.0);
+  EXPECT_EQ(plain.tool.friction_kinetic_ratio, 0.0);
+  const std::string in_solver = replace(good, "collision_method = \"paired\"", "collision_method = \"paired\"\ncontact_response = \"in_solver\"");
+  const std::string both = replace(in_solver, "node_spacing_m = 0.003", "node_spacing_m = 0.003\nfriction_static_ratio = 0.5\nfriction_kinetic_ratio = 0.4");
+  const SceneDescription gripping = load_scene_text(both, "both.toml", kScenes);
+  EXPECT_EQ(gripping.tool.friction_static_ratio, 0.5);
+  EXPECT_EQ(gripping.tool.friction_kinetic_ratio, 0.4);
+  const std::string static_only = replace(in_solver, "node_spacing_m = 0.003", "node_spacing_m = 0.003\nfriction_static_ratio = 0.3");
+  EXPECT_EQ(load_scene_text(static_only, "static.toml", kScenes).tool.friction_kinetic_ratio, 0.3);
+  const std::string too_high = replace(in_solver, "node_spacing_m = 0.003", "node_spacing_m = 0.003\nfriction_static_ratio = 5");
+  expect_error(load_error(too_high), line_of(too_high, "friction_static_ratio"), "tool.friction_static_ratio", "must be in [0, 2] (got 5)");
+  const std::string kinetic_above = replace(in_solver, "node_spacing_m = 0.003", "node_spacing_m = 0.003\nfriction_static_ratio = 0.2\nfriction_kinetic_ratio = 0.4");
+  expect_error(load_error(kinetic_above), line_of(kinetic_above, "friction_kinetic_ratio"), "tool.friction_kinetic_ratio", "must be <= friction_static_ratio (0.2)");
+  const std::string after_step = replace(good, "node_spacing_m = 0.003", "node_spacing_m = 0.003\nfriction_static_ratio = 0.5");
+  expect_error(load_error(after_step), line_of(after_step, "friction_static_ratio"), "tool.friction_static_ratio", "contact_response = \"in_solver\"");
+}
+
 TEST(SceneLoader, ShapeMatchingIsOptionalAndRangeChecked) {
   const std::string shipped = read(kScenes / "spatula-sphere.toml");
   EXPECT_EQ(load_scene_text(shipped, "good.toml", kScenes).soft_body.shape_matching_ratio, 0.05);

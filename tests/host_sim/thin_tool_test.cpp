@@ -113,6 +113,44 @@ TEST(ToolNodesBox, RejectsBadShapes) {
 
 constexpr double kThickness_m = 0.002;
 
+// The rim the in-solver rim constraint drapes soft triangles over: a box's 12 edges, each the
+// length of one of its extents.
+TEST(ToolNodesBox, FeatureEdgesAreTheTwelveBoxEdges) {
+  const ToolNodes tool = ToolNodes::from_box(plate_shape());
+  const auto& edges = tool.feature_edges_tool_m();
+  ASSERT_EQ(edges.size(), 12u);
+  int along[3] = {0, 0, 0};
+  for (const auto& e : edges) {
+    const Eigen::Vector3d d = (e[1] - e[0]).cwiseAbs();
+    int axis = 0;
+    d.maxCoeff(&axis);
+    EXPECT_NEAR(d[axis], 2.0 * plate_shape().half_extents_m[axis], 1e-15);
+    EXPECT_NEAR(d.sum(), d[axis], 1e-15) << "an edge runs along one axis";
+    ++along[axis];
+  }
+  EXPECT_EQ(along[0], 4);
+  EXPECT_EQ(along[1], 4);
+  EXPECT_EQ(along[2], 4);
+}
+
+// A mesh's feature edges are the triangle edges between two different planes: a cube split into
+// 12 triangles has its 12 cube edges, not the 6 face diagonals.
+TEST(ToolNodesConvexMesh, FeatureEdgesLeaveOutEdgesInsideAFlatFace) {
+  ConvexMeshToolShape cube;
+  for (int c = 0; c < 8; ++c) cube.vertices_tool_m.emplace_back((c & 1) ? 0.01 : -0.01, (c & 2) ? 0.001 : -0.001, (c & 4) ? 0.01 : -0.01);
+  // Two triangles per face, outward (counter-clockwise seen from outside).
+  cube.triangles = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+                    {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+  const ToolNodes tool = ToolNodes::from_convex_mesh(cube);
+  ASSERT_EQ(tool.planes().size(), 6u);
+  const auto& edges = tool.feature_edges_tool_m();
+  ASSERT_EQ(edges.size(), 12u);
+  for (const auto& e : edges) {
+    const Eigen::Vector3d d = (e[1] - e[0]).cwiseAbs();
+    EXPECT_EQ((d.array() > 1e-12).count(), 1) << "a cube edge, not a face diagonal: " << d.transpose();
+  }
+}
+
 TEST(RoundedSpatulaMesh, IsAClosedConvexThinMeshWithManyRimTriangles) {
   RoundedSpatulaParams params;
   params.thickness_m = kThickness_m;

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 class btSoftBody;
@@ -220,6 +221,21 @@ int project_contacts(const CollisionModel& model, const StepFrame& frame, btSoft
 // Before the first project_contacts of a step: every candidate's position after the placement,
 // from which the first iteration's moves are judged.
 void start_iterates(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data);
+// The rim constraint (rim_projection.cpp), before the node projection in each iteration: every
+// candidate soft triangle the tool cuts (in front of and behind its plane inside its prism, at
+// most a tool thickness + solver_reach deep) moved back until the deepest tool point lies on it.
+// Returns how many triangles were moved.
+// Over the intersection of the tool with a soft triangle's prism (x: its corners, normal: its unit
+// outward normal, tool frame): the lowest and highest height above the triangle's plane and the
+// lowest point (rim_projection.cpp says why these vertices are exact for a convex tool).
+struct TriangleToolExtent {
+  bool meets = false;
+  double lowest_m = std::numeric_limits<double>::infinity();
+  double highest_m = -std::numeric_limits<double>::infinity();
+  Eigen::Vector3d deepest_tool_m = Eigen::Vector3d::Zero();
+};
+TriangleToolExtent triangle_tool_extent(const ToolNodes& tool, const std::array<Eigen::Vector3d, 3>& x, const Eigen::Vector3d& normal);
+int project_rim_contacts(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft, CollisionData& data);
 void take_solved_shares(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data);
 // Stage 5 (hunt_crossley_force.cpp): HC per contacted triangle, summed; fills out.contacts.
 void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft,

@@ -39,6 +39,8 @@
 #include <BulletSoftBody/btSoftBody.h>
 
 #include <algorithm>
+#include <array>
+#include <limits>
 #include <cmath>
 #include <numbers>
 
@@ -51,6 +53,8 @@ Eigen::Vector3d to_eigen(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
 // triangle stayed on one plane (both are offset + n·(t − rest) in double); a larger gap is a
 // change of the triangle's force plane (1 nm: far below any real indentation step).
 constexpr double kPlaneSwitchTolerance_m = 1.0e-9;
+// A rim point lies on a tool face within this (the clip's rounding on mm-sized tools).
+constexpr double kRimOnPlane_m = 1.0e-7;
 
 Eigen::Vector3d centroid(const SoftSurfaceModel& surface, const btSoftBody& soft, int face, bool start_of_step) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -71,6 +75,86 @@ double filtered_rate(std::int64_t& stamp, double& x_prev_m, double& rate_m_s, st
   stamp = step;
   x_prev_m = x_m;
   return rate_m_s;
+}
+
+// In-solver rim contacts: a candidate triangle with no colliding corner that the tool's rim
+// touches or presses (rim_projection.cpp tents it over the rim) pushes the tool too, or a blade
+// held edge-first in a coarse shell, whose triangles are all draped over its edge, would render
+// nothing. Its share ramps with the rim's gap in front of it as a held node's does (1 touching, 0
+// at release_distance); x is how far the deepest rim point lies behind the triangle's rest plane
+// (at the same barycentric point), weighted as one corner (a third of the rest area), and the
+// force acts along the tool face at that point that faces the triangle most (the proxy's patches
+// are per tool face).
+void rim_contact_forces(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data, double alpha,
+                        CollisionStepResult& out) {
+  const HuntCrossleyParams& hc = model.params.hunt_crossley;
+  const auto& planes = model.tool.planes();
+  const double release_m = model.params.release_distance_m;
+  const double band_m = model.tool.thickness_m() + model.params.solver_reach_m;
+  for (const int face : data.candidate_faces) {
+    const auto f = static_cast<std::size_t>(face);
+    const std::array<int, 3>& nodes = model.soft.face_nodes[f];
+    bool has_colliding_corner = false;
+    std::array<Eigen::Vector3d, 3> x;
+    for (std::size_t k = 0; k < 3; ++k) {
+      has_colliding_corner = has_colliding_corner || data.moved_stamp[static_cast<std::size_t>(nodes[k])] == frame.step;
+      x[k] = frame.r_cur.transpose() * (to_eigen(soft.m_nodes[nodes[k]].m_x) - frame.t_cur);
+    }
+    if (has_colliding_corner) continue;
+    Eigen::Vector3d normal = model.soft.outward_sign * (x[1] - x[0]).cross(x[2] - x[0]);
+    const double twice_area = normal.norm();
+    if (!(twice_area > 0.0)) continue;
+    normal /= twice_area;
+    const TriangleToolExtent extent = triangle_tool_extent(model.tool, x, normal);
+    if (!extent.meets || extent.lowest_m > release_m || extent.lowest_m < -band_m) continue;
+    const double share = release_share(std::max(0.0, extent.lowest_m), release_m);
+    if (!(share > 0.0)) continue;
+    const Eigen::Vector3d& deepest = extent.deepest_tool_m;
+    const Eigen::Vector3d foot = deepest - normal.dot(deepest - x[0]) * normal;
+    Eigen::Vector3d rest_point = Eigen::Vector3d::Zero();
+    for (std::size_t k = 0; k < 3; ++k) {
+      const Eigen::Vector3d& b = x[(k + 1) % 3];
+      const Eigen::Vector3d& c = x[(k + 2) % 3];
+      rest_point += std::max(0.0, normal.dot((c - b).cross(foot - b)) / twice_area) * model.soft.rest_node_world_m[static_cast<std::size_t>(nodes[k])];
+    }
+    const Eigen::Vector3d& r0 = model.soft.rest_node_world_m[static_cast<std::size_t>(nodes[0])];
+    const Eigen::Vector3d rest_normal =
+        (model.soft.outward_sign * (model.soft.rest_node_world_m[static_cast<std::size_t>(nodes[1])] - r0)
+                                       .cross(model.soft.rest_node_world_m[static_cast<std::size_t>(nodes[2])] - r0))
+            .normalized();
+    const Eigen::Vector3d deepest_world = frame.r_cur * deepest + frame.t_cur;
+    const double x_m = std::max(0.0, rest_normal.dot(rest_point - deepest_world));
+    // The tool face through the deepest point that faces the triangle most.
+    int plane_index = -1;
+    double facing = -std::numeric_limits<double>::infinity();
+    for (std::size_t q = 0; q < planes.size(); ++q) {
+      if (std::abs(planes[q].normal_tool.dot(deepest) - planes[q].offset_m) > kRimOnPlane_m) continue;
+      const double facing_q = -planes[q].normal_tool.dot(normal);
+      if (facing_q > facing) {
+        facing = facing_q;
+        plane_index = static_cast<int>(q);
+      }
+    }
+    if (plane_index < 0) continue;
+    const double rate = filtered_rate(data.hc_stamp[f], data.hc_x_prev_m[f], data.hc_rate_filtered_m_s[f], frame.step, x_m, x_m, frame.dt_s, alpha);
+    const double area_weight = hc.per_unit_area ? model.soft.rest_area_m2[f] : 1.0;
+    const double x_pow_n = std::pow(x_m, hc.n);
+    const double force = share * (area_weight / 3.0) * std::max(0.0, hc.k * x_pow_n + hc.lambda * x_pow_n * rate);
+    const Eigen::Vector3d normal_world = frame.r_cur * planes[static_cast<std::size_t>(plane_index)].normal_tool;
+    out.force_on_tool_world_n -= force * normal_world;
+    ContactRecord record;
+    record.soft_face = face;
+    record.tool_node = -1;
+    record.tool_plane = plane_index;
+    record.jaw = model.params.jaw;
+    record.point_world_m = deepest_world;
+    record.normal_world = normal_world;
+    record.penetration_m = x_m;
+    record.penetration_rate_m_s = rate;
+    record.weight = share * area_weight / 3.0;
+    record.force_n = force;
+    out.contacts.push_back(record);
+  }
 }
 
 }  // namespace
@@ -166,6 +250,7 @@ void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, co
     record.force_n = force;
     out.contacts.push_back(record);
   }
+  if (model.params.response == ContactResponse::kInSolver) rim_contact_forces(model, frame, soft, data, alpha, out);
 }
 
 }  // namespace fissure::host::thin_body

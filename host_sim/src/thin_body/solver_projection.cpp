@@ -18,6 +18,13 @@
 //    step if that one faces a way out within a tool thickness, else on the plane the move entered
 //    through (Cyrus–Beck), else (it started inside) on the nearest plane; it is held from then
 //    on. So no node ends the solve inside the tool or on its far side.
+//  * with friction (friction_static_ratio > 0), a held node's move along its face since its
+//    anchor (where it ended the last step it was held, or where it was first held) is undone
+//    while it is within static × this step's normal correction of the node, else shortened by
+//    kinetic × that correction (Coulomb at position level, Macklin et al. 2014): a node on the
+//    tool moves with the tool until the tangential pull exceeds the cone.
+// The rim constraint (rim_projection.cpp) runs before this in each pass, so this projection,
+// which keeps nodes out of the tool, always has the last word.
 // take_solved_shares, after the solve: a held node's share of the force is the smoothstep of its
 // final gap over release_distance (1 on the face, 0 at release), as the post-step hysteresis
 // ramps it; a node beyond release_distance or behind its plane is released.

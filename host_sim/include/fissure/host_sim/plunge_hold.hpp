@@ -55,6 +55,21 @@ struct PlungeTool {
 /// paper's 128-face shell. Loads shipped scenes (throws SceneError when they cannot be found).
 [[nodiscard]] SceneDescription plunge_scene(const PlungeTool& tool, int icosphere_faces = 0);
 
+/// The in-solver cells (contact_response = "in_solver", issue 22): the contact is then as stiff as
+/// the body's own constraints, and a frictionless tool squeezing a free ball against the ground
+/// pushes it out sideways (the ball's centre travelled 5–66 mm over a 0.5 s hold; docs/decisions.md,
+/// "Contact inside the solver") — a bar of soap, not tissue. So the in-solver cells grip as tissue is
+/// gripped: the tool's faces have Coulomb friction, and the ball lies on a bed (its nodes below
+/// kPlungeBedTop_m above the ground tied to it), as a specimen is fixed in a dish.
+/// Static and kinetic ratio of steel on wet soft tissue: 0.5 / 0.4, the upper end of the 0.1–0.5
+/// measured for instruments on tissue (docs/scenes.md, [tool] friction).
+inline constexpr double kPlungeFrictionStaticRatio = 0.5;
+inline constexpr double kPlungeFrictionKineticRatio = 0.4;
+/// The bed: the ball's bottom cap, 15 mm high on the 100 mm ball (15 % of its surface).
+inline constexpr double kPlungeBedTop_m = 0.015;
+/// `scene` (a plunge scene) with the in-solver response, the tool's friction and the ball on its bed.
+[[nodiscard]] SceneDescription in_solver_plunge_scene(SceneDescription scene);
+
 /// Where a plunge starts: the tool kPlungeStartClearance_m above the settled soft surface, and
 /// the height of its origin once the leading face is kPlungeDepth_m below that surface [m, world y].
 struct PlungeStart {

@@ -107,6 +107,10 @@ class ToolNodes {
   [[nodiscard]] const Eigen::AlignedBox3d& bounds_tool_m() const { return bounds_tool_m_; }
   // Vertices of the tool volume (box: 8 corners; mesh: its vertices) for swept bounds.
   [[nodiscard]] const std::vector<Eigen::Vector3d>& hull_vertices_tool_m() const { return hull_vertices_tool_m_; }
+  // The edges where two faces of the tool's volume meet at an angle (box: its 12 edges; mesh: the
+  // triangle edges between two different planes), as end points in the tool frame: the rim a soft
+  // triangle can be draped over, and must not be cut by.
+  [[nodiscard]] const std::vector<std::array<Eigen::Vector3d, 2>>& feature_edges_tool_m() const { return feature_edges_tool_m_; }
 
   // Signed distance to the tool's convex volume from a point in the tool frame: max over planes
   // of (n·p − offset). Exact inside (−depth to the nearest face), a lower bound outside.
@@ -129,6 +133,7 @@ class ToolNodes {
   std::vector<std::uint8_t> edge_node_;
   std::vector<ToolPlane> planes_;
   std::vector<Eigen::Vector3d> hull_vertices_tool_m_;
+  std::vector<std::array<Eigen::Vector3d, 2>> feature_edges_tool_m_;
   // Footprint along the thin axis as 2-D half-planes (a·(u,v) ≤ b) of the projected hull.
   std::vector<Eigen::Vector3d> footprint_halfplanes_;
   PairingReport report_;

@@ -1,0 +1,185 @@
+// The in-solver rim constraint (issue 22, item 2): a soft triangle draped over the tool's rim is
+// tented over it, not cut between its nodes.
+//
+// Why a second primitive: the paired-node stages keep every soft *node* out of the tool, but a
+// coarse triangle (24 mm on the paper's 128-face ball) can lie across a 1 mm blade's edge or a
+// plate's rim with all three nodes outside while the tool passes through its interior. The node
+// projection cannot see that; this constraint is the point–triangle primitive of cloth and IPC
+// contact with the tool's feature edges as the points.
+//
+// The test is exact for a convex tool: over the intersection of the tool with the triangle's
+// prism (the triangle swept along its normal), the lowest and highest height above the
+// triangle's plane are reached at a vertex of that convex set — a tool feature edge where it
+// enters or leaves the prism, or a triangle vertex's normal line where it enters or leaves the
+// tool. The triangle is cut when the tool is both in front of and behind its plane inside the
+// prism; it is then moved back (against its outward normal, into the body) until the deepest
+// tool point lies on it, its free vertices weighted by that point's barycentric coordinates and
+// their inverse masses (the point–triangle projection of position-based dynamics). Only a cut
+// at most a tool thickness + solver_reach deep is resolved: a deeper one is a tool inside the
+// body under the triangle, not a rim across it, and moving the surface that far in one iteration
+// would tear it.
+#include "collision_state.hpp"
+
+#include <BulletSoftBody/btSoftBody.h>
+
+#include <algorithm>
+#include <array>
+#include <limits>
+
+namespace fissure::host::thin_body {
+namespace {
+
+constexpr double kMaxLever = 3.0;
+
+Eigen::Vector3d to_tool(const StepFrame& frame, const btVector3& x_world) {
+  return frame.r_cur.transpose() * (Eigen::Vector3d(x_world.x(), x_world.y(), x_world.z()) - frame.t_cur);
+}
+
+// The segment a → b clipped to the half-spaces m_k·(p − o_k) ≥ 0: false when nothing is left.
+bool clip_to_prism(const std::array<Eigen::Vector3d, 3>& side_normal, const std::array<Eigen::Vector3d, 3>& side_origin,
+                   const Eigen::Vector3d& a, const Eigen::Vector3d& b, double& t0, double& t1) {
+  t0 = 0.0;
+  t1 = 1.0;
+  const Eigen::Vector3d d = b - a;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const double fa = side_normal[k].dot(a - side_origin[k]);
+    const double fd = side_normal[k].dot(d);
+    if (fd == 0.0) {
+      if (fa < 0.0) return false;
+      continue;
+    }
+    const double t = -fa / fd;
+    if (fd > 0.0) {
+      t0 = std::max(t0, t);
+    } else {
+      t1 = std::min(t1, t);
+    }
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+// The line x + s·n clipped to the tool (every plane: normal·p ≤ offset): false when it misses.
+bool clip_line_to_tool(const std::vector<ToolPlane>& planes, const Eigen::Vector3d& x, const Eigen::Vector3d& n, double& s0, double& s1) {
+  s0 = -std::numeric_limits<double>::infinity();
+  s1 = std::numeric_limits<double>::infinity();
+  for (const ToolPlane& q : planes) {
+    const double room = q.offset_m - q.normal_tool.dot(x);
+    const double rate = q.normal_tool.dot(n);
+    if (rate == 0.0) {
+      if (room < 0.0) return false;
+      continue;
+    }
+    const double s = room / rate;
+    if (rate > 0.0) {
+      s1 = std::min(s1, s);
+    } else {
+      s0 = std::max(s0, s);
+    }
+    if (s0 > s1) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+TriangleToolExtent triangle_tool_extent(const ToolNodes& tool, const std::array<Eigen::Vector3d, 3>& x, const Eigen::Vector3d& normal) {
+  std::array<Eigen::Vector3d, 3> side_normal, side_origin;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const Eigen::Vector3d& a = x[k];
+    const Eigen::Vector3d& b = x[(k + 1) % 3];
+    Eigen::Vector3d m = normal.cross(b - a);
+    if (m.dot(x[(k + 2) % 3] - a) < 0.0) m = -m;
+    side_normal[k] = m;
+    side_origin[k] = a;
+  }
+  TriangleToolExtent extent;
+  const auto take = [&](const Eigen::Vector3d& p) {
+    const double h = normal.dot(p - x[0]);
+    if (h < extent.lowest_m) {
+      extent.lowest_m = h;
+      extent.deepest_tool_m = p;
+    }
+    extent.highest_m = std::max(extent.highest_m, h);
+    extent.meets = true;
+  };
+  for (const auto& edge : tool.feature_edges_tool_m()) {
+    double t0 = 0.0, t1 = 0.0;
+    if (!clip_to_prism(side_normal, side_origin, edge[0], edge[1], t0, t1)) continue;
+    const Eigen::Vector3d d = edge[1] - edge[0];
+    take(edge[0] + t0 * d);
+    take(edge[0] + t1 * d);
+  }
+  for (std::size_t k = 0; k < 3; ++k) {
+    double s0 = 0.0, s1 = 0.0;
+    if (!clip_line_to_tool(tool.planes(), x[k], normal, s0, s1)) continue;
+    take(x[k] + s0 * normal);
+    take(x[k] + s1 * normal);
+  }
+  return extent;
+}
+
+int project_rim_contacts(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft, CollisionData& data) {
+  const double band_m = model.tool.thickness_m() + model.params.solver_reach_m;
+  const double tolerance_m = kInsideTolerance_m;
+  int projected = 0;
+  for (const int face : data.candidate_faces) {
+    const std::array<int, 3>& nodes = model.soft.face_nodes[static_cast<std::size_t>(face)];
+    std::array<Eigen::Vector3d, 3> x;
+    std::array<double, 3> inverse_mass{};
+    std::array<double, 3> body_inverse_mass{};
+    for (std::size_t k = 0; k < 3; ++k) {
+      const btSoftBody::Node& node = soft.m_nodes[nodes[k]];
+      x[k] = to_tool(frame, node.m_x);
+      // A node held on a tool face this step is in contact with the rigid tool already: moving it
+      // would break that contact, so the rim moves the free corners only.
+      body_inverse_mass[k] = node.m_im;
+      inverse_mass[k] = (data.hold_stamp[static_cast<std::size_t>(nodes[k])] == frame.step) ? 0.0 : node.m_im;
+    }
+    if (body_inverse_mass[0] + body_inverse_mass[1] + body_inverse_mass[2] == 0.0) continue;
+    Eigen::Vector3d normal = model.soft.outward_sign * (x[1] - x[0]).cross(x[2] - x[0]);
+    const double twice_area = normal.norm();
+    if (!(twice_area > 0.0)) continue;
+    normal /= twice_area;
+    const TriangleToolExtent extent = triangle_tool_extent(model.tool, x, normal);
+    const double lowest_m = extent.lowest_m;
+    const double highest_m = extent.highest_m;
+    const Eigen::Vector3d& deepest = extent.deepest_tool_m;
+    // Cut: the tool is on both sides of the plane inside the prism, no deeper than the band.
+    if (!(lowest_m < -tolerance_m && highest_m > tolerance_m && lowest_m >= -band_m)) continue;
+    // Barycentric coordinates of the deepest point's foot on the triangle.
+    const Eigen::Vector3d foot = deepest - normal.dot(deepest - x[0]) * normal;
+    std::array<double, 3> w{};
+    for (std::size_t k = 0; k < 3; ++k) {
+      const Eigen::Vector3d& b = x[(k + 1) % 3];
+      const Eigen::Vector3d& c = x[(k + 2) % 3];
+      w[k] = std::max(0.0, normal.dot((c - b).cross(foot - b)) / twice_area);
+    }
+    const double depth_m = -lowest_m + model.params.skin_m;
+    // The free corners alone carry the move unless the deepest point lies so near the held ones
+    // that a free corner would travel more than kMaxLever × the depth (3: the most any corner of
+    // a triangle with equal masses travels); then every corner moves, as the body's masses say.
+    double weight_sum = 0.0;
+    double largest_w_over_sum = 0.0;
+    for (std::size_t k = 0; k < 3; ++k) weight_sum += w[k] * w[k] * inverse_mass[k];
+    for (std::size_t k = 0; k < 3; ++k)
+      if (weight_sum > 0.0) largest_w_over_sum = std::max(largest_w_over_sum, w[k] * inverse_mass[k] / weight_sum);
+    if (!(weight_sum > 0.0) || largest_w_over_sum > kMaxLever) {
+      inverse_mass = body_inverse_mass;
+      weight_sum = 0.0;
+      for (std::size_t k = 0; k < 3; ++k) weight_sum += w[k] * w[k] * inverse_mass[k];
+      if (!(weight_sum > 0.0)) continue;
+    }
+    for (std::size_t k = 0; k < 3; ++k) {
+      if (inverse_mass[k] == 0.0 || w[k] == 0.0) continue;
+      const Eigen::Vector3d moved = x[k] - normal * (depth_m * w[k] * inverse_mass[k] / weight_sum);
+      const Eigen::Vector3d moved_world = frame.r_cur * moved + frame.t_cur;
+      soft.m_nodes[nodes[k]].m_x.setValue(static_cast<btScalar>(moved_world.x()), static_cast<btScalar>(moved_world.y()),
+                                          static_cast<btScalar>(moved_world.z()));
+    }
+    ++projected;
+  }
+  return projected;
+}
+
+}  // namespace fissure::host::thin_body
