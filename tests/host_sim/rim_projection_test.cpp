@@ -62,7 +62,7 @@ struct RimFixture {
       const auto& f = model.soft.face_nodes[static_cast<std::size_t>(face)];
       const std::array<Eigen::Vector3d, 3> x{node_tool(f[0]), node_tool(f[1]), node_tool(f[2])};
       const Eigen::Vector3d normal = (model.soft.outward_sign * (x[1] - x[0]).cross(x[2] - x[0])).normalized();
-      const TriangleToolExtent e = triangle_tool_extent(model.tool, x, normal);
+      const TriangleToolExtent e = triangle_tool_extent(model.tool, x, normal, 0.05);
       if (e.meets && e.lowest_m < -kInsideTolerance_m && e.highest_m > kInsideTolerance_m) ++cut;
     }
     return cut;
@@ -78,7 +78,7 @@ TEST(RimProjection, TheExtentOfABladeThroughATriangleIsExact) {
     const auto& f = fx.model.soft.face_nodes[static_cast<std::size_t>(face)];
     const std::array<Eigen::Vector3d, 3> x{fx.node_tool(f[0]), fx.node_tool(f[1]), fx.node_tool(f[2])};
     const Eigen::Vector3d normal = (fx.model.soft.outward_sign * (x[1] - x[0]).cross(x[2] - x[0])).normalized();
-    const TriangleToolExtent e = triangle_tool_extent(fx.model.tool, x, normal);
+    const TriangleToolExtent e = triangle_tool_extent(fx.model.tool, x, normal, 0.05);
     if (!(e.meets && e.lowest_m < 0.0)) continue;
     ++cut;
     // The lowest point is the blade's edge, 1.5 mm behind the flat slab; the highest its back, 38.5 mm in front.

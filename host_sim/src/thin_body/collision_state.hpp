@@ -227,14 +227,16 @@ void start_iterates(const CollisionModel& model, const StepFrame& frame, const b
 // Returns how many triangles were moved.
 // Over the intersection of the tool with a soft triangle's prism (x: its corners, normal: its unit
 // outward normal, tool frame): the lowest and highest height above the triangle's plane and the
-// lowest point (rim_projection.cpp says why these vertices are exact for a convex tool).
+// lowest point (rim_projection.cpp says why these vertices are exact for a convex tool), over the
+// tool edges within reach_m of the triangle's box (callers look no further than that).
 struct TriangleToolExtent {
   bool meets = false;
   double lowest_m = std::numeric_limits<double>::infinity();
   double highest_m = -std::numeric_limits<double>::infinity();
   Eigen::Vector3d deepest_tool_m = Eigen::Vector3d::Zero();
 };
-TriangleToolExtent triangle_tool_extent(const ToolNodes& tool, const std::array<Eigen::Vector3d, 3>& x, const Eigen::Vector3d& normal);
+TriangleToolExtent triangle_tool_extent(const ToolNodes& tool, const std::array<Eigen::Vector3d, 3>& x, const Eigen::Vector3d& normal,
+                                        double reach_m);
 int project_rim_contacts(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft, CollisionData& data);
 void take_solved_shares(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data);
 // Stage 5 (hunt_crossley_force.cpp): HC per contacted triangle, summed; fills out.contacts.

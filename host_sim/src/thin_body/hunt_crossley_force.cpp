@@ -105,7 +105,7 @@ void rim_contact_forces(const CollisionModel& model, const StepFrame& frame, con
     const double twice_area = normal.norm();
     if (!(twice_area > 0.0)) continue;
     normal /= twice_area;
-    const TriangleToolExtent extent = triangle_tool_extent(model.tool, x, normal);
+    const TriangleToolExtent extent = triangle_tool_extent(model.tool, x, normal, std::max(band_m, release_m));
     if (!extent.meets || extent.lowest_m > release_m || extent.lowest_m < -band_m) continue;
     const double share = release_share(std::max(0.0, extent.lowest_m), release_m);
     if (!(share > 0.0)) continue;

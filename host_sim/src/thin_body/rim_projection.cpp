@@ -83,7 +83,27 @@ bool clip_line_to_tool(const std::vector<ToolPlane>& planes, const Eigen::Vector
 
 }  // namespace
 
-TriangleToolExtent triangle_tool_extent(const ToolNodes& tool, const std::array<Eigen::Vector3d, 3>& x, const Eigen::Vector3d& normal) {
+TriangleToolExtent triangle_tool_extent(const ToolNodes& tool, const std::array<Eigen::Vector3d, 3>& x, const Eigen::Vector3d& normal,
+                                        double reach_m) {
+  TriangleToolExtent extent;
+  // A tool wholly beyond reach_m of the triangle's box is either not in its prism or wholly deeper
+  // (or further in front) than the callers look: nothing to report.
+  Eigen::AlignedBox3d near_box;
+  for (const Eigen::Vector3d& corner : x) near_box.extend(corner);
+  near_box.min().array() -= reach_m;
+  near_box.max().array() += reach_m;
+  if (!near_box.intersects(tool.bounds_tool_m())) return extent;
+  // The prism lies inside the cylinder round the centroid's normal line through the farthest
+  // corner: a tool edge that misses the cylinder misses the prism (the rounded spatula has ~10²
+  // feature edges; a candidate triangle's prism meets a few). Exact, unlike a box, at any depth.
+  const Eigen::Vector3d centre = (x[0] + x[1] + x[2]) / 3.0;
+  const auto across = [&](const Eigen::Vector3d& p) {
+    const Eigen::Vector3d d = p - centre;
+    return Eigen::Vector3d(d - normal.dot(d) * normal);
+  };
+  double radius_m = 0.0;
+  for (const Eigen::Vector3d& corner : x) radius_m = std::max(radius_m, across(corner).norm());
+  radius_m += kInsideTolerance_m;
   std::array<Eigen::Vector3d, 3> side_normal, side_origin;
   for (std::size_t k = 0; k < 3; ++k) {
     const Eigen::Vector3d& a = x[k];
@@ -93,7 +113,6 @@ TriangleToolExtent triangle_tool_extent(const ToolNodes& tool, const std::array<
     side_normal[k] = m;
     side_origin[k] = a;
   }
-  TriangleToolExtent extent;
   const auto take = [&](const Eigen::Vector3d& p) {
     const double h = normal.dot(p - x[0]);
     if (h < extent.lowest_m) {
@@ -104,6 +123,11 @@ TriangleToolExtent triangle_tool_extent(const ToolNodes& tool, const std::array<
     extent.meets = true;
   };
   for (const auto& edge : tool.feature_edges_tool_m()) {
+    const Eigen::Vector3d a = across(edge[0]);
+    const Eigen::Vector3d ab = across(edge[1]) - a;
+    const double ab2 = ab.squaredNorm();
+    const double t = ab2 > 0.0 ? std::clamp(-a.dot(ab) / ab2, 0.0, 1.0) : 0.0;
+    if ((a + t * ab).squaredNorm() > radius_m * radius_m) continue;
     double t0 = 0.0, t1 = 0.0;
     if (!clip_to_prism(side_normal, side_origin, edge[0], edge[1], t0, t1)) continue;
     const Eigen::Vector3d d = edge[1] - edge[0];
@@ -141,7 +165,7 @@ int project_rim_contacts(const CollisionModel& model, const StepFrame& frame, bt
     const double twice_area = normal.norm();
     if (!(twice_area > 0.0)) continue;
     normal /= twice_area;
-    const TriangleToolExtent extent = triangle_tool_extent(model.tool, x, normal);
+    const TriangleToolExtent extent = triangle_tool_extent(model.tool, x, normal, band_m);
     const double lowest_m = extent.lowest_m;
     const double highest_m = extent.highest_m;
     const Eigen::Vector3d& deepest = extent.deepest_tool_m;
