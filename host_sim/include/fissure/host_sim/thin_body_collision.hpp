@@ -40,9 +40,10 @@ struct ThinBodyCollisionParams {
   // the share's slope small against a held tool's ±40 µm encoder dither (0.2 mm puts ~7 N/mm
   // of extra stiffness on the coarse ball: force steps of 15 % per dither step).
   double release_distance_m = 2.0e-3;
-  // A held node behind its plane is released, and the tool face is frictionless: putting such a
-  // node back on the face, or Coulomb friction between a held node and the face, make the bench's
-  // paired hold cells and the proxy tests worse (docs/decisions.md, "Held soft nodes").
+  // after_step: a held node behind its plane is released, and the tool face is frictionless:
+  // putting such a node back on the face, or Coulomb friction between a held node and the face,
+  // make the bench's paired hold cells and the proxy tests worse (docs/decisions.md, "Held soft
+  // nodes"). in_solver has its own friction (friction_*_ratio below).
   // ẋ is a finite difference of x filtered by a first-order low-pass with this cut-off
   // (time constant 1/(2π·fc), i.e. ≈1.6 ms lag at 100 Hz).
   double velocity_filter_cutoff_hz = 100.0;
