@@ -145,7 +145,9 @@ TriangleToolExtent triangle_tool_extent(const ToolNodes& tool, const std::array<
 
 int project_rim_contacts(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft, CollisionData& data) {
   const double band_m = model.tool.thickness_m() + model.params.solver_reach_m;
-  const double tolerance_m = kInsideTolerance_m;
+  // A triangle whose corners sit on one tool face (+ skin) has the face skin_m behind it: that is
+  // contact, not a cut. Ten skins of slack leave it alone; the cut metric counts from 0.1 mm.
+  const double tolerance_m = 10.0 * model.params.skin_m;
   int projected = 0;
   for (const int face : data.candidate_faces) {
     const std::array<int, 3>& nodes = model.soft.face_nodes[static_cast<std::size_t>(face)];
