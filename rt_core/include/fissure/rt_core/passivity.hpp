@@ -34,6 +34,10 @@
 //     (the rendered spring is (1 − g) of the environment's), is above the reference, and heads
 //     back to 0 once that is paid — at a hold too: the force does no work there, and what the
 //     full force then stores is counted in U and owed on the way out.
+//     The debt an rt stall leaves (open_stall_account) is kept apart, in the stall account
+//     (kPassivityStallAccountWindow_s): r neither holds for it at the rest nor grows for it on
+//     the rest's buzz, and β does not act on it; r collects it on the way out of the rest
+//     (kPassivityExitGate_m), as the share stall account / U of the force.
 //     Per tick r grows by at most
 //         Δr_max = max_correction_rate_n_per_s · T · (1 + max(0, E')/margin)
 //     i.e. a ramp the hand does not feel as a click while the loop is nearly passive (E' ≤
