@@ -42,7 +42,8 @@ StallCheckTick StallForceCheck::tick(const rt::TelemetrySample& sample) {
   const std::size_t slot = mean_samples_++ % kMeanRingSize;
   commanded_ring_[slot] = as_eigen(sample.force_device_n);
   contact_ring_[slot] = as_eigen(sample.contact_force_device_n);
-  reference_ring_[slot] = rendered_environment_device_n(safety_, sample);
+  // What the device can command of it: safety's clamp (direction kept), as the tick applies it.
+  reference_ring_[slot] = rt::clamp_force_magnitude(rendered_environment_device_n(safety_, sample), safety_.max_force_n);
   if (t_s < window_start_s || mean_samples_ < window_ticks_) return {};
   Eigen::Vector3d commanded = Eigen::Vector3d::Zero(), reference = Eigen::Vector3d::Zero(),
                   contact = Eigen::Vector3d::Zero();

@@ -100,12 +100,28 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
   // The same debt if g stays as it is: the rendered spring is (1 − g) of the environment's and
   // stores (1 − g)·U, so a contact pressed with g in effect owes nothing for the part withheld.
   const double kept_debt_excess_j = debt_excess_j - state.reduction_fraction * stored_j;
+  // The stall account (kPassivityStallAccountWindow_s): booked while its window is open, never
+  // more than the debt (g, β, the damper have paid the rest) nor than U (what is returned later).
+  if (state.stall_window_left_s > 0.0) {
+    state.stall_window_left_s = std::max(0.0, state.stall_window_left_s - period_s);
+    state.stall_debt_j = std::max(state.stall_debt_j, debt_excess_j);
+  }
+  state.stall_debt_j = std::clamp(state.stall_debt_j, 0.0, std::min(std::max(0.0, debt_excess_j), stored_j));
+  const double stall_debt_j = state.stall_debt_j;
+  // The rest the hand holds: followed inwards at once, outwards with kPassivityRestAnchorTime_s.
+  // (p_prev_device_m is this tick's reading: observe_energy ran first.)
+  const Eigen::Vector3d& p_device_m = state.p_prev_device_m;
+  if (force_direction.dot(p_device_m - state.rest_anchor_device_m) < 0.0) state.rest_anchor_device_m = p_device_m;
+  state.rest_anchor_device_m +=
+      std::min(1.0, period_s / kPassivityRestAnchorTime_s) * (p_device_m - state.rest_anchor_device_m);
+  const bool leaving_rest = force_direction.dot(p_device_m - state.rest_anchor_device_m) > kPassivityExitGate_m;
   // While that debt is above the reference g holds (giving the force back while the hand pushes
   // in would store energy the environment returns later; at standstill nothing is paid back)
   // and grows while the environment returns energy (below); once it is paid — by g, by β, or by
   // the device's own damper — g gives the force back, at a hold too: nothing is owed there
   // (what the full force then stores is owed, and withheld, on the way out).
-  double target = kept_debt_excess_j > 0.0 ? state.reduction_fraction : 0.0;
+  // The stall account is not held at rest: it is collected on the way out (below).
+  double target = kept_debt_excess_j - stall_debt_j > 0.0 ? state.reduction_fraction : 0.0;
   double raise_step_n = config.max_correction_step_n;
 
   if (speed >= config.min_speed_m_per_s) {
@@ -121,7 +137,8 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
     const double predicted_all_j =
         state.energy_j + std::max(total.dot(v_filtered_m_per_s), total.dot(v_raw_m_per_s)) * period_s;
     const double excess_all_j = predicted_all_j + config.margin_j;
-    const double predicted_j = predicted_all_j - forgiven_j(state, config.margin_j) - state.damping_credit_j;
+    const double predicted_j =
+        predicted_all_j - forgiven_j(state, config.margin_j) - state.damping_credit_j - stall_debt_j;
 
     // g: while the environment returns energy (F̂·v > 0 by the raw difference, which has no
     // filter lag: gated by the lagging filtered velocity the reduction landed in the next
@@ -130,10 +147,11 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
     const double returning_m_per_s = force_direction.dot(v_raw_m_per_s);  // F̂·v
     // Power the force returns by the filtered velocity (quantisation-free: ≈ 0 at a hold).
     const double returned_power_w = std::max(0.0, force_direction.dot(v_filtered_m_per_s)) * force_n;
-    if (debt_excess_j > 0.0 && returning_m_per_s > 0.0 && force_n > 0.0) {
+    const double loop_debt_excess_j = debt_excess_j - stall_debt_j;
+    if (loop_debt_excess_j > 0.0 && returning_m_per_s > 0.0 && force_n > 0.0) {
       // Withhold the debt from what the force returns over dissipation_time_s (a wall
       // giving back slightly more than it stored)…
-      const double share_for_excess = debt_excess_j / (config.dissipation_time_s * returning_m_per_s * force_n);
+      const double share_for_excess = loop_debt_excess_j / (config.dissipation_time_s * returning_m_per_s * force_n);
       // …unless the loop has already generated more than the ramp's energy budget: then
       // the environment is plainly active (a swap offset left from a contact the host has
       // lost, pushing the hand out at watts) and the push comes off entirely, ramped. Only
@@ -142,6 +160,12 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
       // hc_lambda_over_k_0 stress case, 0.115 J).
       const double share = predicted_j > budget_j ? 1.0 : share_for_excess;
       target = std::max(state.reduction_fraction, std::min(1.0, share));
+    }
+    // The stall account, on the way out of the rest: the share of the force that, held while
+    // the environment returns what it stores, withholds the account by the time U is gone
+    // (stall_debt_j ≤ U, so ≤ 1). Out of the rest only, so a rest keeps the whole wall.
+    if (leaving_rest && stall_debt_j > 0.0 && stored_j > 0.0) {
+      target = std::max(target, std::min(1.0, stall_debt_j / stored_j));
     }
     // The fraction may grow by at most max_correction_step_n of force per tick, steeper in
     // proportion to how much energy has really been created (E' > 0).
@@ -163,9 +187,11 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
 
     // β: the damping that dissipates the excess within dissipation_time_s at this speed,
     // bounded, ramped.
+    // (Not on the stall account: that is collected by g on the way out, see above.)
+    const double loop_excess_all_j = excess_all_j - stall_debt_j;
     const double damping_target =
-        excess_all_j > 0.0
-            ? std::min(config.max_damping_n_s_per_m, excess_all_j / (config.dissipation_time_s * speed * speed))
+        loop_excess_all_j > 0.0
+            ? std::min(config.max_damping_n_s_per_m, loop_excess_all_j / (config.dissipation_time_s * speed * speed))
             : 0.0;
     const double damping_step = config.damping_ramp_s > 0.0
                                     ? config.max_damping_n_s_per_m * period_s / config.damping_ramp_s
@@ -212,6 +238,10 @@ Eigen::Vector3d passivity_control(const PassivityConfig& config, PassivityState&
 
 void record_sent_force(PassivityState& state, const Eigen::Vector3d& force_device_n) noexcept {
   state.force_sent_last_device_n = force_device_n;
+}
+
+void open_stall_account(PassivityState& state) noexcept {
+  state.stall_window_left_s = kPassivityStallAccountWindow_s;
 }
 
 void restart_observer(PassivityState& state) noexcept {

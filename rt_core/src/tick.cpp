@@ -138,8 +138,11 @@ TickResult tick(const RtModel& model, RtData& data, TickIo& io, const TickTiming
   if (history_break && data.have_position) {
     // The device held the command that was acting when the loop stalled while the hand moved:
     // that work is exact (a zero-order hold held longer) and counts in E before the chain restarts.
+    // The debt the stall leaves goes into the stall account (passivity.hpp): collected on the way
+    // out of the rest the hand takes, not withheld at it.
     observe_energy(data.passivity, data.p_device_m);
     restart_observer(data.passivity);
+    open_stall_account(data.passivity);
   }
   if (data.have_position) observe_energy(data.passivity, data.p_device_m);
   update_device_faults(model, data, sample_faults);

@@ -123,6 +123,32 @@ TEST(StallForceCheck, InsideTheRadiusTheReferenceIsTheContactForce) {
   EXPECT_NEAR(short_of_it.error_max(), 0.06, 1e-9);
 }
 
+TEST(StallForceCheck, AContactAboveTheForceClampIsComparedWithWhatTheDeviceCanCommand) {
+  // A 10.1 N contact (the full profile's stall at t = 357.5 s): safety clamps every command to
+  // max_force_n (8 N, direction kept), so the reference is the clamped contact. A command of the
+  // full 8 N along it is exact; 5.6 % short of 8 N fails; 4 % short passes — the tolerance is
+  // still 5 %, of the force the device can command.
+  const rt::SafetyConfig safety;
+  const Eigen::Vector3d contact_n{0.0, 10.1, 0.0};
+  StallForceCheck clamped({kStall}, kPeriod_s, safety);
+  const TraceCounts a =
+      run_trace(clamped, safety, safety.workspace_centre_device_m, contact_n, [&](const Eigen::Vector3d& c, const Eigen::Vector3d&) {
+        return rt::clamp_force_magnitude(c, safety.max_force_n);
+      });
+  EXPECT_EQ(a.over, 0);
+  EXPECT_EQ(a.within, 200);
+  EXPECT_LT(clamped.error_max(), 1e-12);
+  StallForceCheck close_enough({kStall}, kPeriod_s, safety);
+  const TraceCounts b = run_trace(close_enough, safety, safety.workspace_centre_device_m, contact_n,
+                                  [](const Eigen::Vector3d&, const Eigen::Vector3d&) { return Eigen::Vector3d(0.0, 0.96 * 8.0, 0.0); });
+  EXPECT_EQ(b.over, 0);
+  StallForceCheck short_of_it({kStall}, kPeriod_s, safety);
+  const TraceCounts c = run_trace(short_of_it, safety, safety.workspace_centre_device_m, contact_n,
+                                  [](const Eigen::Vector3d&, const Eigen::Vector3d&) { return Eigen::Vector3d(0.0, 0.944 * 8.0, 0.0); });
+  EXPECT_EQ(c.over, 200);
+  EXPECT_NEAR(short_of_it.error_max(), 0.056, 1e-9);
+}
+
 TEST(StallForceCheck, NoContactIsNotCheckedEvenInTheSoftWall) {
   // The soft wall alone (contact below kStressStallMinForce_n) is no contact after a stall.
   const rt::SafetyConfig safety;

@@ -149,6 +149,77 @@ TEST(PassivityController, HoldsTheReductionWhileInExcessAndTheHandPushesIn) {
   EXPECT_NEAR(free.x(), -state.added_damping_n_s_per_m * in.x(), 1e-12);
 }
 
+/// A hand resting on a 500 N/m wall 10 mm deep (5 N, U = 25 mJ) that it never paid for — pressed
+/// in while the loop stalled — buzzing by ±1 count per tick at the rest (v_f ±5 mm/s, v_raw ±50 mm/s),
+/// then leaving at 0.1 m/s. E two margins below the reference at the start: the debt is U less that.
+struct StallRest {
+  static constexpr double kStiffness_n_per_m = 500.0;
+  static constexpr double kDepth_m = 0.01;
+  PassivityConfig config;
+  PassivityState state;
+  StallRest() { state.energy_j = -2.0 * config.margin_j; }
+  double y_m = 0.0;  // outward along the force (+y): the depth is kDepth_m − y_m
+  Eigen::Vector3d out = Eigen::Vector3d::Zero();
+
+  /// One tick with the hand at y_m, moving at v (filtered) / v_raw along +y.
+  void tick(double v_f, double v_raw) {
+    const Eigen::Vector3d p(0.0, y_m, 0.0);
+    observe_energy(state, p);
+    const double x = std::max(0.0, kDepth_m - y_m);
+    const Eigen::Vector3d f(0.0, kStiffness_n_per_m * x, 0.0);
+    out = passivity_control(config, state, f, Eigen::Vector3d(0.0, v_f, 0.0), Eigen::Vector3d(0.0, v_raw, 0.0),
+                            kPeriod_s, 0.5 * kStiffness_n_per_m * x * x);
+    record_sent_force(state, out);
+  }
+  /// 300 ticks of the rest buzz; returns the smallest force rendered.
+  double rest() {
+    double least_n = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 300; ++k) {
+      const double sign = (k % 2 == 0) ? 1.0 : -1.0;
+      y_m = (k % 2 == 0) ? kCount_m : 0.0;
+      tick(sign * 5e-3, sign * 0.05);
+      least_n = std::min(least_n, out.y());
+    }
+    return least_n;
+  }
+};
+
+TEST(PassivityController, AStallsDebtIsNotWithheldAtTheRest) {
+  // The stall account (open_stall_account at the history break) holds the debt: the rest keeps the
+  // whole wall, buzz and all — the wall's own force at every tick (5 N less one count's 0.025 N).
+  StallRest after_stall;
+  open_stall_account(after_stall.state);
+  EXPECT_NEAR(after_stall.rest(), StallRest::kStiffness_n_per_m * (StallRest::kDepth_m - kCount_m), 1e-12);
+  EXPECT_EQ(after_stall.state.reduction_fraction, 0.0);
+  EXPECT_GT(after_stall.state.stall_debt_j, 0.02);
+  // The same debt without a stall (sampled-data activity of the loop) is withheld on the buzz's
+  // outward strokes and held: the wall is held back.
+  StallRest loop_debt;
+  EXPECT_LT(loop_debt.rest(), 0.5 * StallRest::kStiffness_n_per_m * StallRest::kDepth_m);
+  EXPECT_GT(loop_debt.state.reduction_fraction, 0.5);
+}
+
+TEST(PassivityController, AStallsDebtIsCollectedOnTheWayOutOfTheRest) {
+  StallRest s;
+  open_stall_account(s.state);
+  s.rest();
+  const double energy_at_rest_j = s.state.energy_j;
+  // Leaving at 0.1 m/s until the wall is gone (100 ticks) and 50 more.
+  double most_withheld = 0.0;
+  for (int k = 0; k < 150; ++k) {
+    s.y_m += 0.1 * kPeriod_s;
+    s.tick(0.1, 0.1);
+    most_withheld = std::max(most_withheld, s.state.reduction_fraction);
+  }
+  // Rendered in full the wall returns its 25 mJ; with the account collected on the way out what
+  // reaches the hand is what it returns before the hand is kPassivityExitGate_m out of the rest
+  // (≤ 5 N × 0.2 mm = 1 mJ) and while g ramps in within the ramp's energy budget (4 mJ).
+  const double returned_j = s.state.energy_j - energy_at_rest_j;
+  EXPECT_LT(returned_j, 5.0 * kPassivityExitGate_m + kPassivityRampEnergyBudgetMargins * kDefaultPassivityMargin_j);
+  EXPECT_GT(most_withheld, 0.9);
+  EXPECT_EQ(s.state.stall_debt_j, 0.0);  // U is gone: nothing left to collect from this contact
+}
+
 TEST(PassivityController, GivesTheForceBackGraduallyOnceTheEnergyIsBelowTheReference) {
   PassivityConfig config;
   PassivityState state;

@@ -313,6 +313,77 @@ TEST(RtLoop, AfterAStallTheContactForceGoesOnFromWhatTheDeviceHeld) {
   EXPECT_LE(after_max_n, before_n + 0.2);
 }
 
+// Issue 26: the hand rests rest_m into a wall when the loop stalls for 100 ms at the start of a
+// press_m press (0.1 m/s, then a 1 s rest, then back out at 0.1 m/s): the device held the rest's
+// force while the hand went deeper, so the contact the loop resumes on stores energy the hand did
+// not pay for. That debt goes into the stall account (passivity.hpp): not withheld at the rest,
+// collected on the way out. Returns the stress check's figure (20 ms means, 200–400 ms after the
+// stall) and the observer's energy.
+struct StallPressResult {
+  double worst_error_200_400ms = 0.0;  ///< |mean F_cmd − mean F_contact| / |mean F_contact|, 20 ms means
+  double contact_at_check_n = 0.0;
+  double max_observed_energy_j = -1e9;
+  double energy_end_j = 0.0;
+};
+
+StallPressResult run_stall_press(double kWall_n_per_m, double rest_m, double press_m) {
+  constexpr double kWallY_m = -0.004;
+  falcon::SimFalconConfig sim;
+  HandScript hand;
+  hand.start_position_device_m = {0.0, 0.0, kCentreZ_m};
+  hand.waypoints.push_back({{0.0, kWallY_m - rest_m, kCentreZ_m}, 0.05, 0.62 - rest_m / 0.05});
+  hand.waypoints.push_back({{0.0, kWallY_m - rest_m - press_m, kCentreZ_m}, 0.1, 1.0});
+  hand.waypoints.push_back({{0.0, 0.0, kCentreZ_m}, 0.1, 0.5});                  // leave
+  hand.release_at_end = false;
+  sim.hand = hand;
+  Session s(RtConfig{}, sim);
+  // The press starts at 0.08 + 0.62 = 0.7 s: the stall covers its first 100 ms.
+  constexpr double kStallStart_s = 0.7, kStall_s = 0.1, kStallEnd_s = kStallStart_s + kStall_s;
+  constexpr int kMean = 20;  // ticks: 20 ms at 1 kHz, as the stress check
+  bool stalled = false;
+  StallPressResult result;
+  std::vector<double> commanded, contact;
+  TelemetrySample sample;
+  for (int k = 0; k < 2600; ++k) {
+    s.proxy_in.publish(plane_proxy(static_cast<std::uint64_t>(k + 1), {0.0, kWallY_m, 0.0}, {0.0, 1.0, 0.0}, kWall_n_per_m));
+    if (!stalled && to_seconds(s.clock.now()) >= kStallStart_s) {
+      s.clock.advance(static_cast<TimeNs>(kStall_s * 1e9));
+      stalled = true;
+    }
+    s.loop->step();
+    while (s.telemetry->try_pop(sample)) {
+      const double t_s = to_seconds(sample.time_ns);
+      commanded.push_back(sample.force_device_n[1]);
+      contact.push_back(sample.contact_force_device_n[1]);
+      if (t_s >= kStallEnd_s + 0.2 && t_s <= kStallEnd_s + 0.4) {
+        double c = 0.0, e = 0.0;
+        for (int i = 0; i < kMean; ++i) {
+          c += commanded[commanded.size() - 1 - i];
+          e += contact[contact.size() - 1 - i];
+        }
+        result.worst_error_200_400ms = std::max(result.worst_error_200_400ms, std::abs(c - e) / std::abs(e));
+        result.contact_at_check_n = e / kMean;
+      }
+      result.max_observed_energy_j = std::max(result.max_observed_energy_j, sample.energy_j);
+      result.energy_end_j = sample.energy_j;
+    }
+  }
+  EXPECT_TRUE(stalled);
+  return result;
+}
+
+TEST(RtLoop, AWallPressedIntoDuringAStallIsRenderedWithin5PercentFrom200msAfterIt) {
+  // 300 N/m, resting 3 mm in (0.9 N), pressing 6 mm more: the stall leaves the device near the rest
+  // the press ends in (1.35 N against the 300 N/m grip). The controller held 4.9 % of the force back
+  // at the check before the stall account; now none.
+  const StallPressResult r = run_stall_press(300.0, 0.003, 0.006);
+  EXPECT_NEAR(r.contact_at_check_n, 1.35, 0.05);
+  EXPECT_LE(r.worst_error_200_400ms, 0.01);
+  // And the debt is collected on the way out: the observer stays far within the stress bound
+  // (25 mJ) through the rest and the exit.
+  EXPECT_LE(r.max_observed_energy_j, 0.005);
+}
+
 // A device whose exchange takes 2.5 periods of (lockstep) time.
 class SlowDevice final : public falcon::HapticDevice {
  public:

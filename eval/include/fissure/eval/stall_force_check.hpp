@@ -11,7 +11,10 @@
 // with the contact force alone it reads the soft wall as an error (0.12–1.82 N on contacts of
 // ~1.4 N in the full profile). The telemetry records the contact force and the position the
 // tick used; the soft wall is rt_core's own workspace_soft_wall_n of that position with the
-// loop's SafetyConfig — the same function, input and config the tick evaluates.
+// loop's SafetyConfig — the same function, input and config the tick evaluates. The reference is
+// that environment clamped to safety's max_force_n per tick (direction kept, clamp_force_magnitude):
+// safety clamps every command to it, so a contact above it (10.1 and 15.3 N in the full profile)
+// can only be commanded at max_force_n, and compared unclamped no controller could pass it.
 #include <array>
 #include <cstddef>
 #include <cstdint>

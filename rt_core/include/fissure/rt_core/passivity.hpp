@@ -34,6 +34,10 @@
 //     (the rendered spring is (1 − g) of the environment's), is above the reference, and heads
 //     back to 0 once that is paid — at a hold too: the force does no work there, and what the
 //     full force then stores is counted in U and owed on the way out.
+//     The debt an rt stall leaves (open_stall_account) is kept apart, in the stall account
+//     (kPassivityStallAccountWindow_s): r neither holds for it at the rest nor grows for it on
+//     the rest's buzz, and β does not act on it; r collects it on the way out of the rest
+//     (kPassivityExitGate_m), as the share stall account / U of the force.
 //     Per tick r grows by at most
 //         Δr_max = max_correction_rate_n_per_s · T · (1 + max(0, E')/margin)
 //     i.e. a ramp the hand does not feel as a click while the loop is nearly passive (E' ≤
@@ -143,6 +147,29 @@ inline constexpr double kPassivityRecoveryWindow_s = 0.3;
 /// contact rendered at a jumped, false position: 26 mJ in 80 ms) is taken off by g as usual.
 inline constexpr double kPassivityRecoveryForgiveness_j = 10.0 * kDefaultPassivityMargin_j;
 
+/// An rt stall (a sample gap the loop treats as a history break, tick.cpp) is a discontinuity of
+/// the sampled system: for its length the device held one command while the hand moved, and the
+/// contact the loop resumes on stores energy the hand never paid for (pressed in under the held
+/// command) or the held push gave the hand more than the wall stored (pushed out under it). That
+/// debt is not activity of the loop that goes on, and withholding it at rest takes nothing back
+/// (a force at standstill does no work). So the debt booked during this window after a stall —
+/// up to what the environment stores, the part that can still be withheld as it is returned —
+/// goes into a stall account that g collects only while the hand leaves the rest it took (see
+/// kPassivityExitGate_m), and neither g at rest nor β acts on it [s]: the window of a device
+/// fault's recovery (kPassivityRecoveryWindow_s), long enough for the blend to bring the new
+/// contact's force in (≤ 8 N at 0.05 N per 1 kHz tick: 0.16 s).
+inline constexpr double kPassivityStallAccountWindow_s = 0.3;
+/// The hand leaves its rest once it is this far out of it along the force [m]: four encoder
+/// counts, beyond the ±1 count a hold toggles by and the ≈ ±40 µm of a 60 Hz, ±15 mm/s rest buzz,
+/// so the buzz never collects. The rest is an anchor that follows the hand inwards at once and
+/// outwards with kPassivityRestAnchorTime_s; at most this much (× the force) of a stall's debt
+/// is returned before g starts to collect it.
+inline constexpr double kPassivityExitGate_m = 4.0 * kPassivityEncoderCount_m;
+/// Time constant of the rest anchor's outward follow [s]: 0.1 s, longer than a period of the
+/// 7 Hz hand–device resonance (so its settle after a stall reads as a rest) and shorter than the
+/// stall case's 0.2 s before the check, so a new rest is taken within it.
+inline constexpr double kPassivityRestAnchorTime_s = 0.1;
+
 /// Largest credit for the device's own dissipation the reduction g may count against the debt
 /// [J]: what a wall at the Falcon's rated stiffness stores at its rated force, F²/(2K) =
 /// 8²/(2·3000) = 10.7 mJ — a contact's worth. The observer E itself never counts the credit,
@@ -215,6 +242,12 @@ struct PassivityState {
   /// Telemetry: the correction expressed as a damping, |F − F_out| / max(|v_f|, min_speed)
   /// [N·s/m] (F clamped to max_force_n); > 0 exactly when the controller changed the force.
   double damping_n_s_per_m = 0.0;
+  /// The stall account [J]: debt booked after an rt stall that g collects only on the way out of
+  /// the rest (kPassivityStallAccountWindow_s); never more than the debt nor than U.
+  double stall_debt_j = 0.0;
+  double stall_window_left_s = 0.0;  ///< time left to book into the stall account
+  /// The rest the hand holds (kPassivityExitGate_m), device frame [m].
+  Eigen::Vector3d rest_anchor_device_m = Eigen::Vector3d::Zero();
   /// Telemetry: the energy bound raised g this tick (it stepped the force).
   bool energy_bound_acted = false;
   std::uint64_t energy_bound_ticks = 0;  ///< ticks in which the energy bound raised g
@@ -242,5 +275,9 @@ void record_sent_force(PassivityState& state, const Eigen::Vector3d& force_devic
 /// reported separately (recovery_energy_j). The damper β acts on the whole E; the reduction g
 /// on E less up to kPassivityRecoveryForgiveness_j of each window's work.
 void restart_observer(PassivityState& state) noexcept;
+
+/// After an rt stall (tick.cpp's history break, after restart_observer): opens the stall account
+/// for kPassivityStallAccountWindow_s.
+void open_stall_account(PassivityState& state) noexcept;
 
 }  // namespace fissure::rt
