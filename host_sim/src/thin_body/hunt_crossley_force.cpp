@@ -77,6 +77,12 @@ double filtered_rate(std::int64_t& stamp, double& x_prev_m, double& rate_m_s, st
   return rate_m_s;
 }
 
+// One triangle's record; its force pushes the tool along −normal_world (the face's outward normal).
+void add_contact(const ContactRecord& record, CollisionStepResult& out) {
+  out.force_on_tool_world_n -= record.force_n * record.normal_world;
+  out.contacts.push_back(record);
+}
+
 // In-solver rim contacts: a candidate triangle with no colliding corner that the tool's rim
 // touches or presses (rim_projection.cpp tents it over the rim) pushes the tool too, or a blade
 // held edge-first in a coarse shell, whose triangles are all draped over its edge, would render
@@ -141,19 +147,7 @@ void rim_contact_forces(const CollisionModel& model, const StepFrame& frame, con
     const double x_pow_n = std::pow(x_m, hc.n);
     const double force = share * (area_weight / 3.0) * std::max(0.0, hc.k * x_pow_n + hc.lambda * x_pow_n * rate);
     const Eigen::Vector3d normal_world = frame.r_cur * planes[static_cast<std::size_t>(plane_index)].normal_tool;
-    out.force_on_tool_world_n -= force * normal_world;
-    ContactRecord record;
-    record.soft_face = face;
-    record.tool_node = -1;
-    record.tool_plane = plane_index;
-    record.jaw = model.params.jaw;
-    record.point_world_m = deepest_world;
-    record.normal_world = normal_world;
-    record.penetration_m = x_m;
-    record.penetration_rate_m_s = rate;
-    record.weight = share * area_weight / 3.0;
-    record.force_n = force;
-    out.contacts.push_back(record);
+    add_contact(ContactRecord{face, -1, plane_index, model.params.jaw, deepest_world, normal_world, x_m, rate, share * area_weight / 3.0, force}, out);
   }
 }
 
@@ -235,20 +229,7 @@ void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, co
       x_record = x;
       rate_record = rate;
     }
-    out.force_on_tool_world_n -= force * normal_world;
-
-    ContactRecord record;
-    record.soft_face = face;
-    record.tool_node = data.face_lead_node[f];
-    record.tool_plane = plane_index;
-    record.jaw = model.params.jaw;
-    record.point_world_m = c_now;
-    record.normal_world = normal_world;
-    record.penetration_m = x_record;
-    record.penetration_rate_m_s = rate_record;
-    record.weight = weight;
-    record.force_n = force;
-    out.contacts.push_back(record);
+    add_contact(ContactRecord{face, data.face_lead_node[f], plane_index, model.params.jaw, c_now, normal_world, x_record, rate_record, weight, force}, out);
   }
   if (model.params.response == ContactResponse::kInSolver) rim_contact_forces(model, frame, soft, data, alpha, out);
 }

@@ -74,7 +74,7 @@ struct ContactRecord {
                                       // in the set because one of its soft nodes is colliding)
   int tool_plane = -1;                // tool face (index into ToolNodes::planes()) its colliding node is held on
   int jaw = 0;                        // ThinBodyCollisionParams::jaw
-  Eigen::Vector3d point_world_m = Eigen::Vector3d::Zero();   // triangle centroid after the response
+  Eigen::Vector3d point_world_m = Eigen::Vector3d::Zero();   // triangle centroid after the response (in_solver rim contact: the deepest rim point)
   Eigen::Vector3d normal_world = Eigen::Vector3d::Zero();    // tool face outward normal (world)
   double penetration_m = 0.0;         // HC deformation x. centroid_distance: |centroid − rest centroid|;
                                       // normal_displacement: the share-weighted n-mean of its colliding
