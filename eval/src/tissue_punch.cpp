@@ -9,7 +9,7 @@
 // the fixed-node problem allows (fem_world.hpp). Force at each depth: minus the sum of the
 // elastic force on the punch nodes; the slope is the least-squares line through the depths.
 // Sneddon (1965): F = 2 a E* d, E* = E / (1 − ν²), for a half-space; the block is finite (W =
-// 8 a by default), which makes it stiffer — part of what the bound has to hold.
+// 16 a by default), which makes it stiffer — part of what the bound has to hold.
 #include <cmath>
 
 #include "fissure/eval/tissue_validation.hpp"

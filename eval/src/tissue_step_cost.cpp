@@ -10,6 +10,7 @@
 #include "fissure/eval/tissue_validation.hpp"
 #include "fissure/host_sim/fem_world.hpp"
 #include "fissure/host_sim/tet_box.hpp"
+#include "tissue_detail.hpp"
 
 namespace fissure::eval {
 
@@ -28,9 +29,10 @@ StepCostResult time_fem_steps(const StepCostOptions& o) {
   StepCostResult r;
   r.nodes_count = static_cast<int>(mesh.vertices_m.size());
   r.tetrahedra_count = static_cast<int>(mesh.tetrahedra.size());
-  const double substep_s = o.step_s / o.substeps;
+  r.substeps = o.substeps > 0 ? o.substeps : (o.implicit ? 1 : static_cast<int>(std::ceil(o.step_s / tissue_detail::stable_step_s(mesh, o.material))));
+  const double substep_s = o.step_s / r.substeps;
   const auto host_step = [&] {
-    for (int k = 0; k < o.substeps; ++k) world.step(substep_s);
+    for (int k = 0; k < r.substeps; ++k) world.step(substep_s);
   };
   for (int s = 0; s < o.warmup_steps; ++s) host_step();
   std::vector<double> ms;

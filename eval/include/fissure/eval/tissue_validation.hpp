@@ -44,7 +44,7 @@ struct CubeCompressionResult {
 struct FlatPunchOptions {
   int cells_per_radius = 2;          ///< even cells of a / this under and around the punch
   double punch_radius_m = 0.005;
-  double block_half_width_radii = 8.0;  ///< block: ±this × a in x and z, this × a deep
+  double block_half_width_radii = 16.0;  ///< block: ±this × a in x and z, this × a deep
   double growth = 1.3;               ///< cell growth per cell away from the punch
   std::vector<double> depths_m{0.0001, 0.0002};
   host::FemMaterial material = validation_tissue();
@@ -92,8 +92,9 @@ struct StepCostOptions {
   /// Bullet's implicit step (1 Newton iteration, stable at the host step for any mesh) instead of
   /// the symplectic one (explicit elasticity: unstable once the step exceeds ~h_min / c_p).
   bool implicit = false;
-  /// Bullet steps per host step (the symplectic step must stay below ~h_min / c_p).
-  int substeps = 1;
+  /// Bullet steps per host step; 0: as many as the symplectic step's stability needs
+  /// (tissue_detail.hpp stable_step_s, Courant 0.3 of h_min / c_p), 1 for the implicit step.
+  int substeps = 0;
   /// CG cap per Bullet step (FemWorldConfig): measured, the CG runs to its cap whatever its
   /// tolerance, and with mass damping only the system is diagonal (one iteration is exact).
   int cg_max_iterations = 1;
@@ -106,6 +107,7 @@ struct StepCostResult {
   double p95_ms = 0.0;
   bool finite = true;                ///< every node finite after the run
   double max_speed_m_per_s = 0.0;    ///< after the run: a resting block is near 0 when the step is stable
+  int substeps = 1;                  ///< Bullet steps per host step, as run
 };
 [[nodiscard]] StepCostResult time_fem_steps(const StepCostOptions& options);
 
