@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 // Bullet's deformable headers define inline code (btReducedVector, btAlignedObjectArray::resize
 // of default-constructed btVector3) that GCC 12 flags as maybe-uninitialised once inlined here.
@@ -88,9 +89,25 @@ FemWorld::~FemWorld() {
 }
 
 int FemWorld::add_body(const VolumeMesh& mesh, const FemMaterial& material, const FemContact& contact) {
+  // Bullet keeps one force object per force type: addForce attaches a later body to the first
+  // force of its type (btDeformableMultiBodyDynamicsWorld::addForce), with that force's (μ, λ).
+  // Bodies of one world therefore share their material; a different one is refused here rather
+  // than silently simulated with the first body's.
+  if (!bodies_.empty() && (material.model != materials_.front().model || material.youngs_modulus_pa != materials_.front().youngs_modulus_pa ||
+                           material.poisson_ratio != materials_.front().poisson_ratio || material.mass_damping_per_s != materials_.front().mass_damping_per_s ||
+                           material.stiffness_damping_s != materials_.front().stiffness_damping_s)) {
+    throw std::invalid_argument("FemWorld: Bullet's deformable world keeps one force per type, so every body of a world has the first body's elasticity and damping");
+  }
   bodies_.emplace_back(create_fem_body(world_->getWorldInfo(), mesh, material, contact));
+  materials_.push_back(material);
   btSoftBody* body = bodies_.back().get();
   world_->addSoftBody(body);
+  if (bodies_.size() > 1) {
+    // Attached to the first body's forces (the comment above).
+    for (btDeformableLagrangianForce* f : first_body_forces_) world_->addForce(body, f);
+    elastic_.push_back(elastic_.front());
+    return static_cast<int>(bodies_.size()) - 1;
+  }
   const LameParameters lame = bullet_lame_parameters(material);
   const auto mu = static_cast<btScalar>(lame.mu_pa), lambda = static_cast<btScalar>(lame.lambda_pa);
   if (material.model == FemModel::kNeoHookean) {
@@ -100,18 +117,17 @@ int FemWorld::add_body(const VolumeMesh& mesh, const FemMaterial& material, cons
                                                                          static_cast<btScalar>(material.stiffness_damping_s)));
   }
   elastic_.push_back(forces_.back().get());
-  world_->addForce(body, forces_.back().get());
   if (material.model == FemModel::kNeoHookean && material.mass_damping_per_s > 0.0) {
-    // The Neo-Hookean force has no mass-proportional term: Bullet's mass-spring-free damping is
-    // the linear force with zero stiffness and only α.
+    // The Neo-Hookean force has no mass-proportional term: the linear force with zero stiffness
+    // and only α supplies it (the only linear force of the world: all bodies share the model).
     forces_.push_back(std::make_unique<btDeformableLinearElasticityForce>(0, 0, static_cast<btScalar>(material.mass_damping_per_s), 0));
-    world_->addForce(body, forces_.back().get());
   }
-  if (!config_.gravity_world_m_per_s2.isZero()) {
-    forces_.push_back(std::make_unique<btDeformableGravityForce>(bt(config_.gravity_world_m_per_s2)));
-    world_->addForce(body, forces_.back().get());
+  if (!config_.gravity_world_m_per_s2.isZero()) forces_.push_back(std::make_unique<btDeformableGravityForce>(bt(config_.gravity_world_m_per_s2)));
+  for (auto& f : forces_) {
+    first_body_forces_.push_back(f.get());
+    world_->addForce(body, f.get());
   }
-  return static_cast<int>(bodies_.size()) - 1;
+  return 0;
 }
 
 void FemWorld::fix_nodes(int b, const std::vector<int>& nodes) {
@@ -158,20 +174,37 @@ void FemWorld::step(double h_s) noexcept {
 }
 
 void FemWorld::elastic_forces(int b, std::vector<Eigen::Vector3d>& out) {
-  btSoftBody& body = *bodies_[static_cast<std::size_t>(b)];
-  // The force indexes nodes by Node::index, numbered over all bodies of the world.
-  int size = 0;
-  for (int i = 0; i < body.m_nodes.size(); ++i) size = std::max(size, body.m_nodes[i].index + 1);
+  // The force writes each node's share at Node::index, which the solver numbers over all bodies
+  // of the world at its first step (0 for every node before it), and one force object may hold
+  // several bodies (add_body): number every node of the world 0…N−1, body after body, for the
+  // call and put the solver's numbers back.
+  std::vector<int> solver_index;
+  int offset = 0, first = 0;
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    btSoftBody& body = *bodies_[k];
+    if (static_cast<int>(k) == b) first = offset;
+    for (int i = 0; i < body.m_nodes.size(); ++i) {
+      solver_index.push_back(body.m_nodes[i].index);
+      body.m_nodes[i].index = offset++;
+    }
+  }
   btAlignedObjectArray<btVector3> force;
-  force.resize(size, btVector3(0, 0, 0));
+  force.resize(offset, btVector3(0, 0, 0));
   // The scratch (deformation gradient, corotation) is evaluated at m_q; a step overwrites both
   // before it reads them (predictMotion sets m_q from m_x, then advanceDeformation).
-  for (int i = 0; i < body.m_nodes.size(); ++i) body.m_nodes[i].m_q = body.m_nodes[i].m_x;
-  body.updateDeformation();
+  for (auto& body : bodies_) {
+    for (int i = 0; i < body->m_nodes.size(); ++i) body->m_nodes[i].m_q = body->m_nodes[i].m_x;
+    body->updateDeformation();
+  }
   elastic_[static_cast<std::size_t>(b)]->addScaledExplicitForce(1, force);  // the elastic force alone, for both models
+  std::size_t restore = 0;
+  for (auto& body : bodies_) {
+    for (int i = 0; i < body->m_nodes.size(); ++i) body->m_nodes[i].index = solver_index[restore++];
+  }
+  const btSoftBody& body = *bodies_[static_cast<std::size_t>(b)];
   out.resize(static_cast<std::size_t>(body.m_nodes.size()));
   for (int i = 0; i < body.m_nodes.size(); ++i) {
-    const btVector3& f = force[body.m_nodes[i].index];
+    const btVector3& f = force[first + i];
     out[static_cast<std::size_t>(i)] = Eigen::Vector3d(f.x(), f.y(), f.z());
   }
 }

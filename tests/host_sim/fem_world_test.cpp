@@ -5,6 +5,7 @@
 #include "fissure/host_sim/fem_world.hpp"
 
 #include <cmath>
+#include <stdexcept>
 
 #include <BulletSoftBody/btSoftBody.h>
 #include <gtest/gtest.h>
@@ -61,6 +62,45 @@ TEST(FemWorld, AFixedNodeGoesWhereItIsMoved) {
   EXPECT_NEAR(world.node_position_m(body, 0).y(), -0.002, 1e-9);
   // Node 1 (at x = 10 mm, on the edge from node 0 stretched along −x) was pulled after it.
   EXPECT_LT(world.node_position_m(body, 1).x(), 0.01);
+}
+
+}  // namespace
+}  // namespace fissure::host
+
+namespace fissure::host {
+namespace {
+
+TEST(FemWorld, ElasticForcesOfEachBodyBeforeAnyStepSumToZero) {
+  // Two bodies, the second's first node pulled 1 mm out: before a step, Bullet has not numbered
+  // the nodes over the world yet; each body's forces are still its own.
+  const VolumeMesh mesh = make_tet_box(even_coordinates(0.0, 0.01, 1), even_coordinates(0.0, 0.01, 1), even_coordinates(0.0, 0.01, 1));
+  FemWorld world(FemWorldConfig{});
+  const int first = world.add_body(mesh, FemMaterial{});
+  const int second = world.add_body(mesh, FemMaterial{});
+  world.fix_nodes(second, {0});
+  world.move_fixed_node(second, 0, Eigen::Vector3d(-0.001, 0.0, 0.0));
+  std::vector<Eigen::Vector3d> f_first, f_second;
+  world.elastic_forces(first, f_first);
+  world.elastic_forces(second, f_second);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& f : f_first) EXPECT_LT(f.norm(), 1e-9);  // at rest
+  ASSERT_EQ(f_second.size(), mesh.vertices_m.size());
+  for (const Eigen::Vector3d& f : f_second) sum += f;
+  EXPECT_GT(f_second[0].x(), 1e-4);  // the stretched body pulls its moved node back (+x)
+  EXPECT_LT(sum.norm(), 1e-5 * f_second[0].norm());
+}
+
+TEST(FemWorld, ABodyWithAnotherMaterialIsRefused) {
+  // Bullet would attach it to the first body's force, with the first body's (μ, λ).
+  const VolumeMesh mesh = make_tet_box(even_coordinates(0.0, 0.01, 1), even_coordinates(0.0, 0.01, 1), even_coordinates(0.0, 0.01, 1));
+  FemWorld world(FemWorldConfig{});
+  (void)world.add_body(mesh, FemMaterial{});
+  FemMaterial stiffer;
+  stiffer.youngs_modulus_pa = 7000.0;
+  EXPECT_THROW((void)world.add_body(mesh, stiffer), std::invalid_argument);
+  FemMaterial denser;
+  denser.density_kg_per_m3 = 1100.0;  // the density is the body's own (its node masses)
+  EXPECT_EQ(world.add_body(mesh, denser), 1);
 }
 
 }  // namespace

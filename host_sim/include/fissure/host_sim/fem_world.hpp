@@ -68,7 +68,9 @@ class FemWorld {
   FemWorld& operator=(const FemWorld&) = delete;
 
   /// Adds a body (create_fem_body) with its elasticity force (and gravity when configured).
-  /// Returns its index.
+  /// Returns its index. Bullet keeps one force object per force type, so every body of a world
+  /// shares the first body's material: a body with another elasticity or damping throws
+  /// std::invalid_argument (its density and mesh may differ).
   int add_body(const VolumeMesh& mesh, const FemMaterial& material, const FemContact& contact = {});
   [[nodiscard]] int body_count() const noexcept { return static_cast<int>(bodies_.size()); }
   [[nodiscard]] btSoftBody& body(int b) noexcept { return *bodies_[static_cast<std::size_t>(b)]; }
@@ -109,7 +111,9 @@ class FemWorld {
   std::vector<btRigidBody*> boxes_;
   std::vector<std::unique_ptr<btSoftBody>> bodies_;
   std::vector<std::unique_ptr<btDeformableLagrangianForce>> forces_;
-  std::vector<btDeformableLagrangianForce*> elastic_;  ///< per body
+  std::vector<btDeformableLagrangianForce*> elastic_;  ///< per body (all the first body's)
+  std::vector<btDeformableLagrangianForce*> first_body_forces_;
+  std::vector<FemMaterial> materials_;
 };
 
 }  // namespace fissure::host
