@@ -2,8 +2,7 @@
 //
 // The cube stands on Bullet's static ground (top face y = 0) under a kinematic plate; both are
 // frictionless, so the end faces slide freely sideways (uniaxial stress: a cube with its ends
-// fixed to the plates would be stiffer by its barrelling, ~32 % at ν = 0.45 for 6³ cells —
-// measured here). The plate is lowered to the target strain, the cube settles, the strain is
+// fixed to the plates is stiffer by its barrelling, docs/decisions.md "Tissue"). The plate is lowered to the target strain, the cube settles, the strain is
 // measured on the nodes (the contacts let nodes sit within the margin of the plates, so the
 // plate's travel is not the strain), the plate corrected once by the difference, and the cube
 // settled again. Load: the elastic force Bullet's force object puts on the end-face nodes,

@@ -44,8 +44,9 @@ inline constexpr double kBrainYoungsModulusPa = 2000.0;
 /// Liver: 5–10 kPa (Yeh et al. 2002, Ultrasound Med. Biol. 28:467, normal human liver ~5–6 kPa,
 /// fibrotic higher; elastography normal ≤ 7 kPa).
 inline constexpr double kLiverYoungsModulusPa = 7000.0;
-/// Soft tissue is nearly incompressible: ν 0.45–0.49 in the same references; 0.45 keeps linear
-/// tetrahedra from locking badly (docs/decisions.md, "Tissue (issue 24)").
+/// Soft tissue is nearly incompressible: ν 0.45–0.49 in the same references; 0.45 is the low
+/// end, because linear tetrahedra lock (are too stiff in bending) more as ν → 0.5
+/// (docs/decisions.md, "Tissue (issue 24)").
 inline constexpr double kTissuePoissonRatio = 0.45;
 /// Soft tissue density ~1040 kg/m³ (ICRP 23 / ICRU 44 soft tissue, brain 1040).
 inline constexpr double kTissueDensityKgPerM3 = 1040.0;
