@@ -82,7 +82,8 @@ std::string unit_name(const std::string& suffix) {
       {"pa_per_m_pow_n", "Pa per metreⁿ (per unit area)"}, {"n_per_m_pow_n", "N per metreⁿ (per triangle)"},
       {"pa_s_per_m_pow_n_plus_1", "Pa·s per metreⁿ⁺¹ (per unit area)"},
       {"n_s_per_m_pow_n_plus_1", "N·s per metreⁿ⁺¹ (per triangle)"}, {"deg", "degrees"},
-      {"kpr", "Bullet's kPR coefficient"}, {"kvc", "Bullet's kVC coefficient"}};
+      {"kpr", "Bullet's kPR coefficient"}, {"kvc", "Bullet's kVC coefficient"}, {"pa", "pascals"},
+      {"kg_per_m3", "kilograms per cubic metre"}, {"per_s", "per second"}};
   const auto it = kNames.find(suffix);
   return it == kNames.end() ? "'" + suffix + "'" : it->second;
 }

@@ -25,6 +25,7 @@
 #include "fissure/config/table_reader.hpp"
 
 #include "fissure/host_sim/soft_body_builder.hpp"
+#include "fissure/host_sim/tet_mesh_checks.hpp"
 #include "fissure/host_sim/tet_mesh_file.hpp"
 #include "fissure/host_sim/tool_mesh_io.hpp"
 
@@ -126,6 +127,29 @@ void read_anchors(const std::string& file, TableReader& t, SoftBodyDescription& 
   }
 }
 
+// [soft_body] model = "fem": the SI material (fem_material.hpp's ranges and sources); a
+// volumetric body only. The shell's Bullet ratios do not apply and are refused as unknown keys.
+void read_fem_material(const std::string& file, TableReader& t, SoftBodyDescription& soft) {
+  const auto* mesh = std::get_if<SoftMesh>(&soft.shape);
+  if (mesh == nullptr || mesh->tetrahedra.empty()) {
+    t.fail(t.line_for("model", ""), "model", "\"fem\" needs a volumetric body: shape = \"mesh\" with a tetrahedral mesh_path (.msh, .vtk, .node)");
+  }
+  FemMaterial& m = soft.fem;
+  m.model = t.choice<FemModel>("elasticity", {{"corotated_linear", FemModel::kCorotatedLinear}, {"neo_hookean", FemModel::kNeoHookean}},
+                               FemModel::kCorotatedLinear);
+  m.youngs_modulus_pa = t.in_range("youngs_modulus", "pa", kYoungsModulusMinPa, kYoungsModulusMaxPa);
+  m.poisson_ratio = t.in_range("poisson", "ratio", kPoissonRatioMin, kPoissonRatioMax);
+  m.density_kg_per_m3 = t.in_range("density", "kg_per_m3", kDensityMinKgPerM3, kDensityMaxKgPerM3);
+  m.mass_damping_per_s = t.in_range("mass_damping", "per_s", 0.0, kMassDampingMaxPerS, 0.0);
+  m.stiffness_damping_s = t.in_range("stiffness_damping", "s", 0.0, kStiffnessDampingMaxS, 0.0);
+  soft.friction_ratio = t.in_range("friction", "ratio", 0.0, 1.0);
+  soft.collision_margin_m = t.in_range("collision_margin", "m", 0.0, 0.1);
+  TetMesh tet{"", mesh->vertices_world_m, mesh->tetrahedra, {}, 0};
+  soft.mass_kg = m.density_kg_per_m3 * tet_mesh_volume_m3(tet);
+  read_anchors(file, t, soft);
+  t.finish();
+}
+
 void read_soft_body(const std::string& file, TableReader& t, SoftBodyDescription& soft, const std::filesystem::path& base_dir) {
   const std::string shape = t.text("shape");
   if (shape == "sphere") {
@@ -189,6 +213,11 @@ void read_soft_body(const std::string& file, TableReader& t, SoftBodyDescription
     soft.shape = std::move(m);
   } else {
     t.fail(t.line_for("shape", ""), "shape", "'" + shape + "' is not one of: sphere, cylinder, slab, mesh");
+  }
+  soft.model = t.choice<SoftBodyModel>("model", {{"shell", SoftBodyModel::kShell}, {"fem", SoftBodyModel::kFem}}, SoftBodyModel::kShell);
+  if (soft.model == SoftBodyModel::kFem) {
+    read_fem_material(file, t, soft);
+    return;
   }
   soft.mass_kg = t.positive("mass", "kg");
   soft.linear_stiffness_ratio = t.in_range("linear_stiffness", "ratio", 1e-6, 1.0);

@@ -2,6 +2,7 @@
 #include "fissure/host_sim/soft_world.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 
 #include <Eigen/Geometry>
 
@@ -104,6 +105,11 @@ void tool_part_poses(const SceneDescription& scene, const ToolPose& tool, double
 
 SoftWorld::SoftWorld(const SceneDescription& scene, bool tool_collides_in_bullet, bool instrumented_solver)
     : geometry_(tool_part_geometry(scene)), parts_in_world_(tool_collides_in_bullet) {
+  // The FEM body lives in Bullet's deformable world (fem_world.hpp), whose solver is not the
+  // node-bounds solver the thin-body collision reads: refused rather than simulated as a shell.
+  if (scene.soft_body.model == SoftBodyModel::kFem) {
+    throw std::invalid_argument("[soft_body] model = \"fem\": the host simulation does not step FEM bodies yet (issue 24); `fissure bench tissue` runs them");
+  }
   configuration_ = std::make_unique<btSoftBodyRigidBodyCollisionConfiguration>();
   dispatcher_ = std::make_unique<btCollisionDispatcher>(configuration_.get());
   broadphase_ = std::make_unique<btDbvtBroadphase>();

@@ -2,12 +2,16 @@
 // error naming file, line and field; the scripted trajectory is sampled as documented.
 #include "fissure/host_sim/scene_loader.hpp"
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+
+#include "tet_test_meshes.hpp"
 
 namespace fissure::host {
 namespace {
@@ -333,6 +337,71 @@ TEST(SceneTrajectory, LegsAndHoldsAreSampledLinearly) {
   EXPECT_NEAR(sample_trajectory(clamp, 1.0).jaw_gap_m, 0.10, 1e-9);   // 0.02 m/s for 1 s
   // closed to 0.093 after 0.027 m / 0.02 m/s = 1.35 s, held 0.5 s
   EXPECT_NEAR(sample_trajectory(clamp, 1.6).jaw_gap_m, 0.093, 1e-12);
+}
+
+}  // namespace
+}  // namespace fissure::host
+
+namespace fissure::host {
+namespace {
+
+// [soft_body] model = "fem" (issue 24): the SI material keys on a tetrahedral mesh.
+class FemSceneLoader : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() / ("fissure-fem-scene-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_);
+    test_tets::write_vtk(test_tets::kuhn_box({2, 1, 2}, 0.01), dir_ / "block.vtk");
+    shell_ = read(kScenes / "spatula-blob.toml");
+    shell_ = replace(shell_, "\"meshes/organ-blob.obj\"", "\"" + (dir_ / "block.vtk").string() + "\"");
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  // The blob scene's [soft_body] with its shell keys replaced by the FEM ones (`material`).
+  std::string fem_scene(const std::string& material) const {
+    std::string text = shell_;
+    const std::size_t from = text.find("mass_kg = 0.1"), to = text.find("[tool]");
+    text.replace(from, to - from, "model = \"fem\"\n" + material + "friction_ratio = 0.2\ncollision_margin_m = 0.002\n\n");
+    return text;
+  }
+
+  std::filesystem::path dir_;
+  std::string shell_;
+};
+
+const std::string kLiver = "youngs_modulus_pa = 7000.0\npoisson_ratio = 0.45\ndensity_kg_per_m3 = 1040.0\n";
+
+TEST_F(FemSceneLoader, ReadsTheSiMaterialAndTheMassFromDensityAndVolume) {
+  const SceneDescription scene = load_scene_text(fem_scene(kLiver + "elasticity = \"neo_hookean\"\nmass_damping_per_s = 5.0\n"), "good.toml", kScenes);
+  EXPECT_EQ(scene.soft_body.model, SoftBodyModel::kFem);
+  EXPECT_EQ(scene.soft_body.fem.model, FemModel::kNeoHookean);
+  EXPECT_EQ(scene.soft_body.fem.youngs_modulus_pa, 7000.0);
+  EXPECT_EQ(scene.soft_body.fem.poisson_ratio, 0.45);
+  EXPECT_EQ(scene.soft_body.fem.density_kg_per_m3, 1040.0);
+  EXPECT_EQ(scene.soft_body.fem.mass_damping_per_s, 5.0);
+  EXPECT_EQ(scene.soft_body.fem.stiffness_damping_s, 0.0);
+  EXPECT_NEAR(scene.soft_body.mass_kg, 1040.0 * 0.02 * 0.01 * 0.02, 1e-12);
+  // The defaults: a shell unless told otherwise, corotated linear elasticity.
+  EXPECT_EQ(load_scene_text(shell_, "good.toml", kScenes).soft_body.model, SoftBodyModel::kShell);
+  EXPECT_EQ(load_scene_text(fem_scene(kLiver), "good.toml", kScenes).soft_body.fem.model, FemModel::kCorotatedLinear);
+}
+
+TEST_F(FemSceneLoader, OutOfRangeMaterialNamesFileLineFieldValueAndRange) {
+  const std::string soft = fem_scene(replace(kLiver, "youngs_modulus_pa = 7000.0", "youngs_modulus_pa = 7.0"));
+  expect_error(load_error(soft), line_of(soft, "youngs_modulus_pa = 7.0"), "soft_body.youngs_modulus_pa", "must be in [10, 1e+07] (got 7)");
+  const std::string incompressible = fem_scene(replace(kLiver, "poisson_ratio = 0.45", "poisson_ratio = 0.5"));
+  expect_error(load_error(incompressible), line_of(incompressible, "poisson_ratio = 0.5"), "soft_body.poisson_ratio", "must be in [0, 0.49] (got 0.5)");
+  const std::string dense = fem_scene(replace(kLiver, "density_kg_per_m3 = 1040.0", "density_kg_per_m3 = 10400.0"));
+  expect_error(load_error(dense), line_of(dense, "density_kg_per_m3 = 10400.0"), "soft_body.density_kg_per_m3", "must be in [100, 5000] (got 1.04e+04)");
+  const std::string kpa = fem_scene(replace(kLiver, "youngs_modulus_pa = 7000.0", "youngs_modulus_kpa = 7.0"));
+  expect_error(load_error(kpa), line_of(kpa, "youngs_modulus_kpa"), "soft_body.youngs_modulus_kpa", "wrong unit");
+}
+
+TEST_F(FemSceneLoader, ShellKeysAndSurfaceMeshesAreRefused) {
+  const std::string with_shell_key = fem_scene(kLiver + "linear_stiffness_ratio = 1.0\n");
+  expect_error(load_error(with_shell_key), line_of(with_shell_key, "linear_stiffness_ratio"), "soft_body.linear_stiffness_ratio", "unknown key");
+  std::string surface = replace(fem_scene(kLiver), (dir_ / "block.vtk").string(), "meshes/organ-blob.obj");
+  expect_error(load_error(surface), line_of(surface, "model = \"fem\""), "soft_body.model", "needs a volumetric body");
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include <variant>
 #include <vector>
 
+#include "fissure/host_sim/fem_material.hpp"
 #include "fissure/shared/messages.hpp"
 #include "fissure/shared/session_config.hpp"
 
@@ -103,8 +104,16 @@ struct SoftAnchorBox {
   Vec3 max_world_m{0.0, 0.0, 0.0};
 };
 
+/// What simulates the soft body ([soft_body] model): Bullet's classic soft body (edge links,
+/// kLST; the paper's shell) or FEM in Bullet's deformable world with an SI material (fem_world.hpp).
+enum class SoftBodyModel : std::uint8_t { kShell, kFem };
+
 struct SoftBodyDescription {
   std::variant<SoftSphere, SoftCylinder, SoftSlab, SoftMesh> shape{SoftSphere{}};
+  SoftBodyModel model = SoftBodyModel::kShell;
+  /// model = kFem: the SI material (the shell keys kLST … piterations are then not read);
+  /// mass_kg is then density × the mesh's volume.
+  FemMaterial fem{};
   double mass_kg = 0.1;
   double linear_stiffness_ratio = 0.5;     ///< Bullet material kLST ∈ (0, 1]
   double pressure_kpr = 0.0;               ///< Bullet config kPR (pressure coefficient), ≥ 0

@@ -1,0 +1,65 @@
+#pragma once
+// Small helpers shared by the tissue validations (tissue_validation.hpp).
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "fissure/host_sim/fem_material.hpp"
+#include "fissure/host_sim/fem_world.hpp"
+#include "fissure/host_sim/soft_body_builder.hpp"
+
+namespace fissure::eval::tissue_detail {
+
+inline Eigen::Vector3d e3(const Vec3& v) { return {v[0], v[1], v[2]}; }
+
+/// Indices of the mesh's vertices that satisfy `keep` (rest positions).
+inline std::vector<int> nodes_where(const host::VolumeMesh& mesh, const std::function<bool(const Eigen::Vector3d&)>& keep) {
+  std::vector<int> out;
+  for (std::size_t i = 0; i < mesh.vertices_m.size(); ++i) {
+    if (keep(e3(mesh.vertices_m[i]))) out.push_back(static_cast<int>(i));
+  }
+  return out;
+}
+
+/// Shortest tetrahedron edge [m].
+inline double shortest_edge_m(const host::VolumeMesh& mesh) {
+  double h = std::numeric_limits<double>::infinity();
+  for (const auto& t : mesh.tetrahedra) {
+    for (int a = 0; a < 4; ++a) {
+      for (int b = a + 1; b < 4; ++b) h = std::min(h, (e3(mesh.vertices_m[static_cast<std::size_t>(t[a])]) - e3(mesh.vertices_m[static_cast<std::size_t>(t[b])])).norm());
+    }
+  }
+  return h;
+}
+
+/// The symplectic step's stable size: a fraction (Courant number) of the P-wave's transit of the
+/// shortest edge. 0.3 leaves room for the diagonal edges of a Kuhn cell, which are not the
+/// shortest but whose elements are the stiffest.
+inline double stable_step_s(const host::VolumeMesh& mesh, const host::FemMaterial& material, double courant = 0.3) {
+  return courant * shortest_edge_m(mesh) / host::p_wave_speed_m_per_s(material);
+}
+
+inline Eigen::Vector3d sum_over(const std::vector<Eigen::Vector3d>& f, const std::vector<int>& nodes) {
+  Eigen::Vector3d s = Eigen::Vector3d::Zero();
+  for (int n : nodes) s += f[static_cast<std::size_t>(n)];
+  return s;
+}
+
+/// Quasi-static solve with Bullet's implicit step (fem_world.hpp): steps of `step_s` until every
+/// node of the body moves slower than `speed_tolerance_m_per_s` (the state no longer changes by
+/// more than that × step per step) or `max_steps` are done. Backward Euler at a step near the
+/// specimen's slowest period damps every mode strongly, and each step's truncated CG (at most
+/// 300 iterations in Bullet) continues from where the last one stopped. Returns the steps taken.
+inline int settle_implicit(host::FemWorld& world, int body, double step_s, int max_steps, double speed_tolerance_m_per_s) {
+  for (int s = 1; s <= max_steps; ++s) {
+    world.step(step_s);
+    if (world.max_node_speed_m_per_s(body) < speed_tolerance_m_per_s) return s;
+  }
+  return max_steps;
+}
+
+}  // namespace fissure::eval::tissue_detail

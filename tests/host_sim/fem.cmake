@@ -1,0 +1,6 @@
+# Tissue FEM (issue 24): SI materials mapped onto Bullet's deformable-world forces, structured
+# tetrahedral boxes, and the deformable world with fixed nodes and reaction forces.
+fissure_add_test(host_sim_fem_material_test SOURCES fem_material_test.cpp LIBS fissure_host_sim)
+fissure_add_test(host_sim_tet_box_test SOURCES tet_box_test.cpp LIBS fissure_host_sim)
+fissure_add_test(host_sim_fem_body_test SOURCES fem_body_test.cpp LIBS fissure_host_sim)
+fissure_add_test(host_sim_fem_world_test SOURCES fem_world_test.cpp LIBS fissure_host_sim)
