@@ -251,6 +251,10 @@ SurfaceMesh read_soft_body_mesh(const std::string& path) {
 VolumeMesh read_soft_body_tet_mesh(const std::string& path) {
   TetMesh tet = read_tet_mesh_file(path, kSoftMeshMaxTetrahedra);
   (void)weld_and_compact(tet);
+  return volume_mesh_from(std::move(tet));
+}
+
+VolumeMesh volume_mesh_from(TetMesh tet) {
   TetBoundary boundary = check_tet_mesh(tet);
   VolumeMesh mesh;
   mesh.vertices_m = std::move(tet.vertices_m);

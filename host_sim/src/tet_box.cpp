@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -107,12 +108,7 @@ VolumeMesh make_tet_box(const std::vector<double>& xs, const std::vector<double>
       }
     }
   }
-  TetBoundary boundary = check_tet_mesh(tet);
-  VolumeMesh mesh;
-  mesh.vertices_m = std::move(tet.vertices_m);
-  mesh.tetrahedra = std::move(tet.tetrahedra);
-  mesh.boundary_triangles = std::move(boundary.triangles);
-  return mesh;
+  return volume_mesh_from(std::move(tet));
 }
 
 }  // namespace fissure::host

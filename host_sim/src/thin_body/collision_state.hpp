@@ -225,6 +225,26 @@ void start_iterates(const CollisionModel& model, const StepFrame& frame, const b
 // candidate soft triangle the tool cuts (in front of and behind its plane inside its prism, at
 // most a tool thickness + solver_reach deep) moved back until the deepest tool point lies on it.
 // Returns how many triangles were moved.
+// A world position in the tool frame at the step's current pose, and back.
+inline Eigen::Vector3d to_tool(const StepFrame& frame, const btVector3& x_world) {
+  return frame.r_cur.transpose() * (Eigen::Vector3d(x_world.x(), x_world.y(), x_world.z()) - frame.t_cur);
+}
+inline void write_tool_position(const StepFrame& frame, const Eigen::Vector3d& p_tool, btVector3& x_world) {
+  const Eigen::Vector3d p_world = frame.r_cur * p_tool + frame.t_cur;
+  x_world.setValue(static_cast<btScalar>(p_world.x()), static_cast<btScalar>(p_world.y()), static_cast<btScalar>(p_world.z()));
+}
+
+// A soft triangle in the tool frame (current positions): its corners, unit outward normal and
+// twice its area. false for a degenerate (zero-area) triangle.
+struct SoftTriangleInTool {
+  std::array<Eigen::Vector3d, 3> x;
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  double twice_area = 0.0;
+};
+bool soft_triangle_in_tool(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, int face, SoftTriangleInTool& out);
+// Barycentric coordinates (clamped ≥ 0) of the foot of `point` on the triangle's plane.
+std::array<double, 3> barycentric_of_foot(const SoftTriangleInTool& triangle, const Eigen::Vector3d& point);
+
 // Over the intersection of the tool with a soft triangle's prism (x: its corners, normal: its unit
 // outward normal, tool frame): the lowest and highest height above the triangle's plane and the
 // lowest point (rim_projection.cpp says why these vertices are exact for a convex tool), over the

@@ -100,29 +100,18 @@ void rim_contact_forces(const CollisionModel& model, const StepFrame& frame, con
   for (const int face : data.candidate_faces) {
     const auto f = static_cast<std::size_t>(face);
     const std::array<int, 3>& nodes = model.soft.face_nodes[f];
-    bool has_colliding_corner = false;
-    std::array<Eigen::Vector3d, 3> x;
-    for (std::size_t k = 0; k < 3; ++k) {
-      has_colliding_corner = has_colliding_corner || data.moved_stamp[static_cast<std::size_t>(nodes[k])] == frame.step;
-      x[k] = frame.r_cur.transpose() * (to_eigen(soft.m_nodes[nodes[k]].m_x) - frame.t_cur);
-    }
-    if (has_colliding_corner) continue;
-    Eigen::Vector3d normal = model.soft.outward_sign * (x[1] - x[0]).cross(x[2] - x[0]);
-    const double twice_area = normal.norm();
-    if (!(twice_area > 0.0)) continue;
-    normal /= twice_area;
-    const TriangleToolExtent extent = triangle_tool_extent(model.tool, x, normal, std::max(band_m, release_m));
+    if (std::any_of(nodes.begin(), nodes.end(), [&](int node) { return data.moved_stamp[static_cast<std::size_t>(node)] == frame.step; })) continue;
+    SoftTriangleInTool triangle;
+    if (!soft_triangle_in_tool(model, frame, soft, face, triangle)) continue;
+    const Eigen::Vector3d& normal = triangle.normal;
+    const TriangleToolExtent extent = triangle_tool_extent(model.tool, triangle.x, normal, std::max(band_m, release_m));
     if (!extent.meets || extent.lowest_m > release_m || extent.lowest_m < -band_m) continue;
     const double share = release_share(std::max(0.0, extent.lowest_m), release_m);
     if (!(share > 0.0)) continue;
     const Eigen::Vector3d& deepest = extent.deepest_tool_m;
-    const Eigen::Vector3d foot = deepest - normal.dot(deepest - x[0]) * normal;
+    const std::array<double, 3> w = barycentric_of_foot(triangle, deepest);
     Eigen::Vector3d rest_point = Eigen::Vector3d::Zero();
-    for (std::size_t k = 0; k < 3; ++k) {
-      const Eigen::Vector3d& b = x[(k + 1) % 3];
-      const Eigen::Vector3d& c = x[(k + 2) % 3];
-      rest_point += std::max(0.0, normal.dot((c - b).cross(foot - b)) / twice_area) * model.soft.rest_node_world_m[static_cast<std::size_t>(nodes[k])];
-    }
+    for (std::size_t k = 0; k < 3; ++k) rest_point += w[k] * model.soft.rest_node_world_m[static_cast<std::size_t>(nodes[k])];
     const Eigen::Vector3d& r0 = model.soft.rest_node_world_m[static_cast<std::size_t>(nodes[0])];
     const Eigen::Vector3d rest_normal =
         (model.soft.outward_sign * (model.soft.rest_node_world_m[static_cast<std::size_t>(nodes[1])] - r0)

@@ -31,10 +31,6 @@ namespace {
 
 constexpr double kMaxLever = 3.0;
 
-Eigen::Vector3d to_tool(const StepFrame& frame, const btVector3& x_world) {
-  return frame.r_cur.transpose() * (Eigen::Vector3d(x_world.x(), x_world.y(), x_world.z()) - frame.t_cur);
-}
-
 // The segment a → b clipped to the half-spaces m_k·(p − o_k) ≥ 0: false when nothing is left.
 bool clip_to_prism(const std::array<Eigen::Vector3d, 3>& side_normal, const std::array<Eigen::Vector3d, 3>& side_origin,
                    const Eigen::Vector3d& a, const Eigen::Vector3d& b, double& t0, double& t1) {
@@ -82,6 +78,28 @@ bool clip_line_to_tool(const std::vector<ToolPlane>& planes, const Eigen::Vector
 }
 
 }  // namespace
+
+bool soft_triangle_in_tool(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, int face, SoftTriangleInTool& out) {
+  const std::array<int, 3>& nodes = model.soft.face_nodes[static_cast<std::size_t>(face)];
+  for (std::size_t k = 0; k < 3; ++k) out.x[k] = to_tool(frame, soft.m_nodes[nodes[k]].m_x);
+  out.normal = model.soft.outward_sign * (out.x[1] - out.x[0]).cross(out.x[2] - out.x[0]);
+  out.twice_area = out.normal.norm();
+  if (!(out.twice_area > 0.0)) return false;
+  out.normal /= out.twice_area;
+  return true;
+}
+
+std::array<double, 3> barycentric_of_foot(const SoftTriangleInTool& triangle, const Eigen::Vector3d& point) {
+  const auto& x = triangle.x;
+  const Eigen::Vector3d foot = point - triangle.normal.dot(point - x[0]) * triangle.normal;
+  std::array<double, 3> w{};
+  for (std::size_t k = 0; k < 3; ++k) {
+    const Eigen::Vector3d& b = x[(k + 1) % 3];
+    const Eigen::Vector3d& c = x[(k + 2) % 3];
+    w[k] = std::max(0.0, triangle.normal.dot((c - b).cross(foot - b)) / triangle.twice_area);
+  }
+  return w;
+}
 
 TriangleToolExtent triangle_tool_extent(const ToolNodes& tool, const std::array<Eigen::Vector3d, 3>& x, const Eigen::Vector3d& normal,
                                         double reach_m) {
@@ -151,36 +169,22 @@ int project_rim_contacts(const CollisionModel& model, const StepFrame& frame, bt
   int projected = 0;
   for (const int face : data.candidate_faces) {
     const std::array<int, 3>& nodes = model.soft.face_nodes[static_cast<std::size_t>(face)];
-    std::array<Eigen::Vector3d, 3> x;
     std::array<double, 3> inverse_mass{};
     std::array<double, 3> body_inverse_mass{};
     for (std::size_t k = 0; k < 3; ++k) {
-      const btSoftBody::Node& node = soft.m_nodes[nodes[k]];
-      x[k] = to_tool(frame, node.m_x);
       // A node held on a tool face this step is in contact with the rigid tool already: moving it
       // would break that contact, so the rim moves the free corners only.
-      body_inverse_mass[k] = node.m_im;
-      inverse_mass[k] = (data.hold_stamp[static_cast<std::size_t>(nodes[k])] == frame.step) ? 0.0 : node.m_im;
+      body_inverse_mass[k] = soft.m_nodes[nodes[k]].m_im;
+      inverse_mass[k] = (data.hold_stamp[static_cast<std::size_t>(nodes[k])] == frame.step) ? 0.0 : body_inverse_mass[k];
     }
     if (body_inverse_mass[0] + body_inverse_mass[1] + body_inverse_mass[2] == 0.0) continue;
-    Eigen::Vector3d normal = model.soft.outward_sign * (x[1] - x[0]).cross(x[2] - x[0]);
-    const double twice_area = normal.norm();
-    if (!(twice_area > 0.0)) continue;
-    normal /= twice_area;
-    const TriangleToolExtent extent = triangle_tool_extent(model.tool, x, normal, band_m);
+    SoftTriangleInTool triangle;
+    if (!soft_triangle_in_tool(model, frame, soft, face, triangle)) continue;
+    const TriangleToolExtent extent = triangle_tool_extent(model.tool, triangle.x, triangle.normal, band_m);
     const double lowest_m = extent.lowest_m;
-    const double highest_m = extent.highest_m;
-    const Eigen::Vector3d& deepest = extent.deepest_tool_m;
     // Cut: the tool is on both sides of the plane inside the prism, no deeper than the band.
-    if (!(lowest_m < -tolerance_m && highest_m > tolerance_m && lowest_m >= -band_m)) continue;
-    // Barycentric coordinates of the deepest point's foot on the triangle.
-    const Eigen::Vector3d foot = deepest - normal.dot(deepest - x[0]) * normal;
-    std::array<double, 3> w{};
-    for (std::size_t k = 0; k < 3; ++k) {
-      const Eigen::Vector3d& b = x[(k + 1) % 3];
-      const Eigen::Vector3d& c = x[(k + 2) % 3];
-      w[k] = std::max(0.0, normal.dot((c - b).cross(foot - b)) / twice_area);
-    }
+    if (!(lowest_m < -tolerance_m && extent.highest_m > tolerance_m && lowest_m >= -band_m)) continue;
+    const std::array<double, 3> w = barycentric_of_foot(triangle, extent.deepest_tool_m);
     const double depth_m = -lowest_m + model.params.skin_m;
     // The free corners alone carry the move unless the deepest point lies so near the held ones
     // that a free corner would travel more than kMaxLever × the depth (3: the most any corner of
@@ -198,10 +202,7 @@ int project_rim_contacts(const CollisionModel& model, const StepFrame& frame, bt
     }
     for (std::size_t k = 0; k < 3; ++k) {
       if (inverse_mass[k] == 0.0 || w[k] == 0.0) continue;
-      const Eigen::Vector3d moved = x[k] - normal * (depth_m * w[k] * inverse_mass[k] / weight_sum);
-      const Eigen::Vector3d moved_world = frame.r_cur * moved + frame.t_cur;
-      soft.m_nodes[nodes[k]].m_x.setValue(static_cast<btScalar>(moved_world.x()), static_cast<btScalar>(moved_world.y()),
-                                          static_cast<btScalar>(moved_world.z()));
+      write_tool_position(frame, triangle.x[k] - triangle.normal * (depth_m * w[k] * inverse_mass[k] / weight_sum), soft.m_nodes[nodes[k]].m_x);
     }
     ++projected;
   }

@@ -38,15 +38,6 @@
 namespace fissure::host::thin_body {
 namespace {
 
-Eigen::Vector3d to_tool(const StepFrame& frame, const btVector3& x_world) {
-  return frame.r_cur.transpose() * (Eigen::Vector3d(x_world.x(), x_world.y(), x_world.z()) - frame.t_cur);
-}
-
-void write_tool_position(const StepFrame& frame, const Eigen::Vector3d& p_tool, btSoftBody::Node& node) {
-  const Eigen::Vector3d p_world = frame.r_cur * p_tool + frame.t_cur;
-  node.m_x.setValue(static_cast<btScalar>(p_world.x()), static_cast<btScalar>(p_world.y()), static_cast<btScalar>(p_world.z()));
-}
-
 // The plane a free node found inside the tool leaves by (see the file comment for the order).
 int exit_plane(const CollisionModel& model, const StepFrame& frame, const CollisionData& data, int node, const Eigen::Vector3d& a,
                const Eigen::Vector3d& p_tool) {
@@ -155,7 +146,7 @@ int project_contacts(const CollisionModel& model, const StepFrame& frame, btSoft
     }
     data.iterate_tool_m[n] = p;
     if (!moved) continue;
-    write_tool_position(frame, p, soft_node);
+    write_tool_position(frame, p, soft_node.m_x);
     ++projected;
   }
   return projected;

@@ -12,6 +12,7 @@
 #include <LinearMath/btScalar.h>
 
 #include "fissure/host_sim/scene_description.hpp"
+#include "fissure/host_sim/tet_mesh.hpp"
 
 class btRigidBody;
 class btSoftBody;
@@ -65,6 +66,9 @@ struct VolumeMesh {
 /// connected volume with a closed manifold boundary, no overlap, at most kSoftMeshMaxTetrahedra.
 /// Throws MeshError naming the file, the element (tetrahedron and its line) and the reason.
 [[nodiscard]] VolumeMesh read_soft_body_tet_mesh(const std::string& path);
+/// A checked tetrahedral mesh as a VolumeMesh: check_tet_mesh (throws naming the element) gives
+/// its outward boundary triangles.
+[[nodiscard]] VolumeMesh volume_mesh_from(TetMesh tet);
 
 /// A volumetric btSoftBody: a node per vertex with the lumped mass density × (a quarter of the
 /// volume of each tetrahedron it is a corner of), a link per tetrahedron edge (once), a Bullet
