@@ -25,6 +25,7 @@
 #include "fissure/session/session_error.hpp"
 #include "bench_pareto_command.hpp"
 #include "bench_mesh_command.hpp"
+#include "bench_grasp_command.hpp"
 #include "bench_tissue_command.hpp"
 
 namespace {
@@ -81,6 +82,7 @@ int main(int argc, char** argv) {
   fissure::app::register_bench_pareto(tree);
   fissure::app::register_bench_mesh(tree);
   fissure::app::register_bench_tissue(tree);
+  fissure::app::register_bench_grasp(tree);
 
   if (const std::string unknown = unknown_subcommand(root, argc, argv); !unknown.empty()) {
     std::fprintf(stderr, "fissure: error: %s (see 'fissure --help')\n", unknown.c_str());

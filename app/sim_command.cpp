@@ -3,6 +3,8 @@
 // trace and a summary JSON. `--write-meshes DIR` regenerates the shipped tool meshes.
 #include "sim_command.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -152,7 +154,8 @@ std::ofstream open_csv_trace(const std::filesystem::path& path) {
   csv.open(path);
   if (!csv) throw CommandError("cannot write the CSV trace '" + path.string() + "'");
   csv << "time_s,tool_x_m,tool_y_m,tool_z_m,jaw_gap_m,force_x_n,force_y_n,force_z_n,jaw_a_force_n,jaw_b_force_n,contacts,"
-         "crossed_nodes,max_penetration_m,step_us,collision_us\n";
+         "crossed_nodes,max_penetration_m,step_us,collision_us,friction_x_n,friction_y_n,friction_z_n,jaw_a_normal_n,jaw_a_friction_n,"
+         "jaw_b_normal_n,jaw_b_friction_n\n";
   csv.precision(9);
   return csv;
 }
@@ -162,7 +165,18 @@ void write_csv_row(std::ofstream& csv, const host::HostSimulation& sim, const ho
   csv << r.time_s << ',' << p.x() << ',' << p.y() << ',' << p.z() << ',' << r.jaw_gap_m << ',' << r.force_on_tool_world_n.x() << ','
       << r.force_on_tool_world_n.y() << ',' << r.force_on_tool_world_n.z() << ',' << r.part_force_world_n[0].norm() << ','
       << (r.part_count > 1 ? r.part_force_world_n[1].norm() : 0.0) << ',' << r.contact_count << ',' << r.crossing.crossed_nodes << ','
-      << r.crossing.max_penetration_m << ',' << r.times.total_s * 1e6 << ',' << r.times.collision_s * 1e6 << '\n';
+      << r.crossing.max_penetration_m << ',' << r.times.total_s * 1e6 << ',' << r.times.collision_s * 1e6;
+  // Friction (in_solver with [tool] friction) and, per jaw, the normal (Hunt-Crossley) and friction parts.
+  Eigen::Vector3d friction = Eigen::Vector3d::Zero();
+  std::array<double, 2> normal_n{0.0, 0.0}, friction_n{0.0, 0.0};
+  for (int part = 0; part < std::min(r.part_count, 2); ++part) {
+    const Eigen::Vector3d& f = r.part_results[static_cast<std::size_t>(part)].friction_force_on_tool_world_n;
+    friction += f;
+    friction_n[static_cast<std::size_t>(part)] = f.norm();
+    normal_n[static_cast<std::size_t>(part)] = (r.part_force_world_n[static_cast<std::size_t>(part)] - f).norm();
+  }
+  csv << ',' << friction.x() << ',' << friction.y() << ',' << friction.z() << ',' << normal_n[0] << ',' << friction_n[0] << ',' << normal_n[1] << ','
+      << friction_n[1] << '\n';
 }
 
 // --frames: PNGs of every frame_every-th step, drawn by viewer/'s writer thread from the

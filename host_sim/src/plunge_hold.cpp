@@ -142,6 +142,9 @@ PlungeHoldResult run_plunge_hold(const SceneDescription& scene, SceneCollisionMe
     record(r);
     if (i < settle_steps) continue;
     result.hold_force_n.push_back(r.force_on_tool_world_n.norm());
+    Eigen::Vector3d friction = Eigen::Vector3d::Zero();
+    for (int part = 0; part < r.part_count; ++part) friction += r.part_results[static_cast<std::size_t>(part)].friction_force_on_tool_world_n;
+    result.hold_friction_mean_n += friction.norm() / static_cast<double>(hold_steps);
     const int triangles = contacted_triangles(r);
     if (i == settle_steps) result.ball_centre_hold_start_world_m = ball_centre();
     else if (triangles != previous_triangles) ++result.hold_contact_set_changes;

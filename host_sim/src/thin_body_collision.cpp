@@ -55,6 +55,9 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision, public SoftContact
       throw std::invalid_argument("thin-body collision: step() got a different soft body than at construction");
     if (!(dt_s > 0.0) || !std::isfinite(dt_s)) throw std::invalid_argument("thin-body collision: dt_s must be > 0");
     out.force_on_tool_world_n.setZero();
+    out.friction_force_on_tool_world_n.setZero();
+    out.sticking_nodes = 0;
+    out.sliding_nodes = 0;
     out.contacts.clear();
     if (out.contacts.capacity() < static_cast<std::size_t>(model_.soft.face_count))
       out.reserve_for(model_.soft.face_count);  // first call only
@@ -89,6 +92,7 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision, public SoftContact
     const Clock::time_point t1 = Clock::now();
     out.seconds_response += seconds_between(t0, t1);
     thin_body::hunt_crossley_force(model_, frame_, soft, data_, out);
+    if (in_solver()) thin_body::friction_force_on_tool(model_, frame_, soft, data_, out);
     out.contacted_triangles = static_cast<int>(data_.contacted_faces.size());
     out.seconds_force = seconds_between(t1, Clock::now());
   }

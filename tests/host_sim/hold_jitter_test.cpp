@@ -105,9 +105,9 @@ void check_every_speed(const PlungeTool& tool, ContactResponse response, bool ex
     const int set_changes = c.hold_contact_set_changes;
     const Vec3& a = c.ball_centre_hold_start_world_m;
     const Vec3& b = c.ball_centre_hold_end_world_m;
-    std::printf("%-29s %5.1f m/s: crossed %d, penetration %.4f mm, F_hold %.3f N, jitter %.3f %% | contact-set changes %d, "
+    std::printf("%-29s %5.1f m/s: crossed %d, penetration %.4f mm, F_hold %.3f N (friction %.3f N), jitter %.3f %% | contact-set changes %d, "
                 "ball centre moved (%.1f, %.1f) mm in x, z over the hold | cut triangles max %d, on %d of %zu hold steps\n",
-                label.c_str(), speed, c.crossed_nodes, c.max_penetration_m * 1e3, c.hold.mean_n, 100.0 * c.hold.jitter,
+                label.c_str(), speed, c.crossed_nodes, c.max_penetration_m * 1e3, c.hold.mean_n, c.hold_friction_mean_n, 100.0 * c.hold.jitter,
                 set_changes, (b[0] - a[0]) * 1e3, (b[2] - a[2]) * 1e3, c.hold_max_cut_triangles, c.hold_steps_with_cut_triangles,
                 c.hold_force_n.size());
     const test_oracle::RunTally& t = check.tally;

@@ -57,6 +57,7 @@ void take_rest_state(const btSoftBody& soft, SoftSurfaceModel& model) {
   }
   model.rest_centroid_world_m.resize(static_cast<std::size_t>(model.face_count));
   model.rest_area_m2.resize(static_cast<std::size_t>(model.face_count));
+  model.node_rest_area_m2.assign(static_cast<std::size_t>(model.node_count), 0.0);
   double volume6 = 0.0;
   double area_sum = 0.0;
   model.max_rest_edge_m = 0.0;
@@ -69,6 +70,7 @@ void take_rest_state(const btSoftBody& soft, SoftSurfaceModel& model) {
     model.rest_centroid_world_m[static_cast<std::size_t>(f)] = (a + b + c) / 3.0;
     const double area = 0.5 * (b - a).cross(c - a).norm();
     model.rest_area_m2[static_cast<std::size_t>(f)] = area;
+    for (const int node : nodes) model.node_rest_area_m2[static_cast<std::size_t>(node)] += area / 3.0;
     area_sum += area;
     volume6 += (a - reference).dot((b - reference).cross(c - reference));
     model.max_rest_edge_m = std::max({model.max_rest_edge_m, (b - a).norm(), (c - b).norm(), (a - c).norm()});
@@ -160,7 +162,8 @@ void allocate_collision_data(const CollisionModel& model, CollisionData& data) {
   data.iterate_tool_m.assign(soft_nodes, Eigen::Vector3d::Zero());
   data.friction_anchor_tool_m.assign(soft_nodes, Eigen::Vector3d::Zero());
   data.friction_anchor_stamp.assign(soft_nodes, -1);
-  data.normal_push_m.assign(soft_nodes, 0.0);
+  data.friction_correction_tool_m.assign(soft_nodes, Eigen::Vector3d::Zero());
+  data.friction_sliding.assign(soft_nodes, 0);
   data.candidate_nodes.clear();
   data.candidate_nodes.reserve(soft_nodes);
   data.sweep_plane_had_contact.assign(model.tool.planes().size(), 0);

@@ -39,6 +39,7 @@ struct SoftSurfaceModel {
   std::vector<Eigen::Vector3d> rest_node_world_m;      // rest positions (world, when the rest state was taken)
   std::vector<Eigen::Vector3d> rest_centroid_world_m;  // centroid_distance's rest centroids
   std::vector<double> rest_area_m2;
+  std::vector<double> node_rest_area_m2;  // a third of the rest area of the faces round each node (its nodal quadrature weight)
   double outward_sign = 1.0;   // multiplies Bullet's winding normal to point out of the soft body
   double max_rest_edge_m = 0.0;
   Eigen::AlignedBox3d rest_bounds_world_m;  // bounds of rest_node_world_m (the broad phase's seed clip side)
@@ -126,10 +127,12 @@ struct CollisionData {
   std::vector<Eigen::Vector3d> iterate_tool_m;  // in_solver: each candidate's position after the last projection (tool frame, current pose)
   // In-solver friction: where a held node sticks (tool frame; the node's position at the end of
   // the step it was last held, or where it was first held this step), valid at friction_anchor_stamp,
-  // and the normal correction the contact applied to it this step (m, ≥ 0).
+  // and the tangential correction friction has applied to it so far this step (tool frame, m; the
+  // position-level friction impulse × h / m) with whether it was the whole move (stick) or the cone's share (slide).
   std::vector<Eigen::Vector3d> friction_anchor_tool_m;
   std::vector<std::int64_t> friction_anchor_stamp;
-  std::vector<double> normal_push_m;
+  std::vector<Eigen::Vector3d> friction_correction_tool_m;
+  std::vector<std::uint8_t> friction_sliding;
   // Node sweep (node_sweep.cpp), per tool plane: a node of it was in contact last step / the
   // current triangle may touch a node of it.
   std::vector<std::uint8_t> sweep_plane_had_contact;
@@ -259,6 +262,14 @@ TriangleToolExtent triangle_tool_extent(const ToolNodes& tool, const std::array<
                                         double reach_m);
 int project_rim_contacts(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft, CollisionData& data);
 void take_solved_shares(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data);
+// After the solve, with friction: the friction force on the tool, the reaction to every candidate's
+// friction impulse this step (m·correction/h²), and how many held nodes stuck and slid.
+void friction_force_on_tool(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, const CollisionData& data,
+                            CollisionStepResult& out);
+// The elastic Hunt-Crossley normal force a node held on `plane` carries at the current pose and
+// `gap_m` in front of the plane (share · nodal weight · k·xⁿ): what the force stage gives it, and
+// the normal force its friction cone is taken from.
+double held_node_normal_force(const CollisionModel& model, const StepFrame& frame, int node, const ToolPlane& plane, double gap_m);
 // Stage 5 (hunt_crossley_force.cpp): HC per contacted triangle, summed; fills out.contacts.
 void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft,
                          CollisionData& data, CollisionStepResult& out);

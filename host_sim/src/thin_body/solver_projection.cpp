@@ -20,9 +20,12 @@
 //    on. So no node ends the solve inside the tool or on its far side.
 //  * with friction (friction_static_ratio > 0), a held node's move along its face since its
 //    anchor (where it ended the last step it was held, or where it was first held) is undone
-//    while it is within static × this step's normal correction of the node, else shortened by
-//    kinetic × that correction (Coulomb at position level, Macklin et al. 2014): a node on the
-//    tool moves with the tool until the tangential pull exceeds the cone.
+//    while undoing it costs at most static × F_n·h²/m — F_n the node's Hunt-Crossley normal force,
+//    so F_n·h is the normal impulse the tool gives it in the step — else undone by kinetic ×
+//    F_n·h²/m only (Coulomb at position level, Macklin et al. 2014): a node on the tool moves with
+//    the tool until the tangential pull exceeds the cone. The correction accumulates over the
+//    iterations (as XPBD accumulates a multiplier), so several iterations never spend the cone
+//    twice, and m·correction/h² is the friction force the node puts on the tool.
 // The rim constraint (rim_projection.cpp) runs before this in each pass, so this projection,
 // which keeps nodes out of the tool, always has the last word.
 // take_solved_shares, after the solve: a held node's share of the force is the smoothstep of its
@@ -33,6 +36,7 @@
 #include <BulletSoftBody/btSoftBody.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace fissure::host::thin_body {
@@ -72,19 +76,15 @@ int exit_plane(const CollisionModel& model, const StepFrame& frame, const Collis
 
 }  // namespace
 
-void start_iterates(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data) {
-  const auto& planes = model.tool.planes();
+void start_iterates(const CollisionModel& /*model*/, const StepFrame& frame, const btSoftBody& soft, CollisionData& data) {
   for (const int node : data.candidate_nodes) {
     const auto n = static_cast<std::size_t>(node);
     const Eigen::Vector3d p = to_tool(frame, soft.m_nodes[node].m_x);
     data.iterate_tool_m[n] = p;
-    data.normal_push_m[n] = 0.0;
+    data.friction_correction_tool_m[n].setZero();
+    data.friction_sliding[n] = 0;
     if (data.hold_stamp[n] != frame.step) continue;
-    // Placed by the detection: the placement's move along the face normal (from the prediction,
-    // end_tool_m) is this step's first normal correction, and a node not held last step sticks
-    // where it was placed.
-    const ToolPlane& plane = planes[static_cast<std::size_t>(data.hold_plane[n])];
-    data.normal_push_m[n] = std::max(0.0, plane.normal_tool.dot(p - data.end_tool_m[n]));
+    // Placed by the detection: a node not held last step sticks where it was placed.
     if (data.friction_anchor_stamp[n] != frame.step - 1) {
       data.friction_anchor_tool_m[n] = p;
       data.friction_anchor_stamp[n] = frame.step;
@@ -124,7 +124,6 @@ int project_contacts(const CollisionModel& model, const StepFrame& frame, btSoft
     bool moved = false;
     if (push_m > 0.0) {
       p += push_m * plane.normal_tool;
-      data.normal_push_m[n] += push_m;
       moved = true;
     }
     if (data.friction_anchor_stamp[n] < frame.step - 1) {
@@ -132,15 +131,26 @@ int project_contacts(const CollisionModel& model, const StepFrame& frame, btSoft
       data.friction_anchor_tool_m[n] = p;
       data.friction_anchor_stamp[n] = frame.step;
     }
-    if (mu_static > 0.0 && data.normal_push_m[n] > 0.0) {
-      // Coulomb at position level: the tangential move since the anchor against the cone of this
-      // step's normal correction.
-      Eigen::Vector3d slip = p - data.friction_anchor_tool_m[n];
-      slip -= plane.normal_tool.dot(slip) * plane.normal_tool;
-      const double slip_m = slip.norm();
-      if (slip_m > 0.0) {
-        const double stick_limit_m = mu_static * data.normal_push_m[n];
-        p -= slip_m <= stick_limit_m ? slip : slip * std::min(1.0, mu_kinetic * data.normal_push_m[n] / slip_m);
+    if (mu_static > 0.0) {
+      // Coulomb at position level: the tangential move since the anchor that friction has not
+      // already undone this step, against the cone of the node's normal impulse.
+      const double normal_force_n = held_node_normal_force(model, frame, node, plane, plane.normal_tool.dot(p) - plane.offset_m);
+      Eigen::Vector3d& correction = data.friction_correction_tool_m[n];
+      Eigen::Vector3d free_slip = p - data.friction_anchor_tool_m[n] - correction;
+      free_slip -= plane.normal_tool.dot(free_slip) * plane.normal_tool;
+      const double free_slip_m = free_slip.norm();
+      const double cone_m = normal_force_n * frame.dt_s * frame.dt_s * soft_node.m_im;  // F_n·h²/m
+      Eigen::Vector3d wanted = Eigen::Vector3d::Zero();
+      data.friction_sliding[n] = 0;
+      if (free_slip_m <= mu_static * cone_m) {
+        wanted = -free_slip;
+      } else if (free_slip_m > 0.0) {
+        wanted = -free_slip * (mu_kinetic * cone_m / free_slip_m);
+        data.friction_sliding[n] = 1;
+      }
+      if (wanted != correction) {
+        p += wanted - correction;
+        correction = wanted;
         moved = true;
       }
     }
@@ -150,6 +160,38 @@ int project_contacts(const CollisionModel& model, const StepFrame& frame, btSoft
     ++projected;
   }
   return projected;
+}
+
+double held_node_normal_force(const CollisionModel& model, const StepFrame& frame, int node, const ToolPlane& plane, double gap_m) {
+  const HuntCrossleyParams& hc = model.params.hunt_crossley;
+  const auto v = static_cast<std::size_t>(node);
+  const Eigen::Vector3d normal_world = frame.r_cur * plane.normal_tool;
+  const double x_m = plane.offset_m + normal_world.dot(frame.t_cur - model.soft.rest_node_world_m[v]);
+  if (!(x_m > 0.0)) return 0.0;
+  const double nodal_weight = hc.per_unit_area
+                                  ? model.soft.node_rest_area_m2[v]
+                                  : (model.soft.faces_of_node_begin[v + 1] - model.soft.faces_of_node_begin[v]) / 3.0;
+  return release_share(gap_m, model.params.release_distance_m) * nodal_weight * hc.k * std::pow(x_m, hc.n);
+}
+
+void friction_force_on_tool(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, const CollisionData& data,
+                            CollisionStepResult& out) {
+  if (!(model.params.friction_static_ratio > 0.0)) return;
+  Eigen::Vector3d force_tool = Eigen::Vector3d::Zero();
+  const double inverse_h2 = 1.0 / (frame.dt_s * frame.dt_s);
+  for (const int node : data.candidate_nodes) {
+    const auto n = static_cast<std::size_t>(node);
+    const double im = soft.m_nodes[node].m_im;
+    if (im == 0.0) continue;
+    const Eigen::Vector3d& correction = data.friction_correction_tool_m[n];
+    if (correction.isZero(0.0)) continue;
+    // The correction moved the node by −(its tangential pull); the tool takes the reaction.
+    force_tool -= correction * (inverse_h2 / im);
+    (data.friction_sliding[n] != 0 ? out.sliding_nodes : out.sticking_nodes) += 1;
+  }
+  const Eigen::Vector3d force_world = frame.r_cur * force_tool;
+  out.friction_force_on_tool_world_n += force_world;
+  out.force_on_tool_world_n += force_world;
 }
 
 void take_solved_shares(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data) {

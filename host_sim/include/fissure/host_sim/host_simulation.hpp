@@ -99,6 +99,8 @@ class HostSimulation {
   [[nodiscard]] int triangles_cut_by_tool(double depth_tolerance_m) const;
   [[nodiscard]] int soft_node_count() const noexcept;
   [[nodiscard]] const ToolPose& tool_pose() const noexcept { return tool_pose_; }
+  /// Pose of tool part p (the clamp's jaw A = 0, B = 1; a one-part tool: the tool) after the last step.
+  [[nodiscard]] const ToolPose& part_pose(int part) const noexcept { return part_poses_[static_cast<std::size_t>(part)]; }
   /// Axis-aligned bounds of the soft nodes (world) as of the last step/settle.
   [[nodiscard]] Eigen::AlignedBox3d soft_bounds_world_m() const noexcept;
 

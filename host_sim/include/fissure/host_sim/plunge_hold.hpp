@@ -97,6 +97,7 @@ struct PlungeHoldResult {
   int crossed_nodes = 0, wrong_side_nodes = 0, inside_nodes = 0;  ///< worst step
   double max_penetration_m = 0.0;
   std::vector<double> hold_force_n;  ///< |F| per step of the measured hold window
+  double hold_friction_mean_n = 0.0; ///< mean over the hold of |the friction part of F| (in_solver with friction)
   // What the diagnosis of a jittery cell needs (is the contact set chattering, or is the ball
   // moving?), over the measured hold window:
   int hold_contact_set_changes = 0;   ///< steps whose force-set triangle count differs from the step before's

@@ -58,10 +58,13 @@ struct ThinBodyCollisionParams {
   // displacement in one step; the hold-and-sweep tests check no node ends inside.
   double solver_reach_m = 1.0e-3;
   // In-solver: Coulomb friction of a held node on its tool face, at position level (Macklin et al.
-  // 2014, "Unified particle physics", §6.1): within one step a node's tangential move relative to
-  // the tool is undone while it is at most static × the normal correction the contact applied to
-  // it this step (both are impulse × h / m, so their ratio is the force ratio), else shortened by
-  // kinetic × that normal correction. 0: frictionless.
+  // 2014, "Unified particle physics", §6.1), against the node's own Hunt-Crossley normal force
+  // F_n (the elastic part the force stage gives it, s_v·(w_v)·k·x_vⁿ): within one step the node's
+  // tangential move relative to the tool is undone while that costs at most static × F_n·h²/m
+  // (the friction impulse within the cone of the normal impulse F_n·h), else undone by kinetic ×
+  // F_n·h²/m only (sliding on the cone). So the friction the solver applies and the friction the
+  // tool feels (CollisionStepResult::friction_force_on_tool_world_n, m·correction/h²) obey one
+  // Coulomb law of the rendered normal force. 0: frictionless.
   double friction_static_ratio = 0.0;
   double friction_kinetic_ratio = 0.0;
 };
@@ -88,7 +91,10 @@ struct ContactRecord {
 };
 
 struct CollisionStepResult {
-  Eigen::Vector3d force_on_tool_world_n = Eigen::Vector3d::Zero();
+  Eigen::Vector3d force_on_tool_world_n = Eigen::Vector3d::Zero();  // normal (Hunt-Crossley) + friction
+  Eigen::Vector3d friction_force_on_tool_world_n = Eigen::Vector3d::Zero();  // of which friction (in_solver with friction)
+  int sticking_nodes = 0;         // in_solver friction: held nodes whose tangential move friction undid whole this step ...
+  int sliding_nodes = 0;          // ... and those that slid on the cone's boundary
   std::vector<ContactRecord> contacts;  // reserved once by reserve_for(), reused (no allocation)
   int colliding_tool_nodes = 0;   // tool nodes in contact after the exclusion
   int excluded_pairs = 0;         // tool nodes excluded as the non-leading node of a pair in contact

@@ -1,0 +1,37 @@
+// The pull-out experiment (eval/src/grasp_pull.cpp) on the shipped retraction scene: a gripped,
+// end-anchored vessel pulled along its length slides through the jaws, the friction force along
+// the pull stays within the Coulomb limit μ·(both jaws' normal force), and a firmer grip pulls harder.
+#include "fissure/eval/grasp.hpp"
+
+#include <gtest/gtest.h>
+
+namespace fissure::eval {
+namespace {
+
+GraspPullResult pull(double jaw_gap_m) {
+  GraspPullOptions options;
+  options.scene = grasp_pull_scene();
+  options.jaw_gap_m = jaw_gap_m;
+  options.friction_ratio = 0.3;
+  options.pull_distance_m = 0.008;
+  return run_grasp_pull(options);
+}
+
+TEST(GraspPull, TheVesselSlidesThroughTheJawsWithinTheCoulombLimitAndAFirmerGripPullsHarder) {
+  const GraspPullResult loose = pull(0.024);
+  const GraspPullResult firm = pull(0.018);
+  for (const GraspPullResult* r : {&loose, &firm}) {
+    ASSERT_TRUE(r->finite);
+    EXPECT_EQ(r->crossed_nodes_max, 0);
+    EXPECT_GT(r->grip_n, 0.05);
+    EXPECT_GT(r->slip_m, 0.5 * 0.008) << "anchored, the vessel cannot follow the jaws: they slide along it";
+    // Sliding friction never exceeds μ·(F_A + F_B) = 2μ·grip (a node's cone is its own normal force).
+    EXPECT_GT(r->pull_out_n, 0.0);
+    EXPECT_LE(r->pull_out_n, 2.0 * 0.3 * r->grip_n * 1.05);
+  }
+  EXPECT_GT(firm.grip_n, 2.0 * loose.grip_n);
+  EXPECT_GT(firm.pull_out_n, 2.0 * loose.pull_out_n);
+}
+
+}  // namespace
+}  // namespace fissure::eval
