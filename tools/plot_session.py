@@ -1,5 +1,6 @@
 #!/usr/bin/python3
-"""Plot a `fissure run` trace: force, penetration, proxy age and, for a clamp, the jaw gap against time.
+"""Plot a `fissure run` trace: force, penetration, proxy age and, for a clamp, the jaw gap and the per-jaw
+normal and friction force against time.
 
 usage: plot_session.py TRACE.csv OUT.png [--title TEXT]
 Uses only the standard library's csv module and matplotlib (Debian's python3-matplotlib).
@@ -16,7 +17,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 REQUIRED_COLUMNS = ["time_s", "force_n", "contact_force_n", "host_force_n", "penetration_m",
                     "host_penetration_m", "proxy_age_ms"]
 # Traces written before the jaw gap was recorded have no such column: they plot without it.
-OPTIONAL_COLUMNS = ["host_jaw_gap_m"]
+OPTIONAL_COLUMNS = ["host_jaw_gap_m", "host_jaw_a_normal_n", "host_jaw_a_friction_n", "host_jaw_b_normal_n",
+                    "host_jaw_b_friction_n"]
 
 
 def read_trace(path):
@@ -40,7 +42,8 @@ def is_clamp(columns):
 def build_figure(columns, title=""):
     t = columns["time_s"]
     clamp = is_clamp(columns)
-    rows = 4 if clamp else 3
+    has_jaw_forces = clamp and all(f"host_jaw_{jaw}_{part}_n" in columns for jaw in ("a", "b") for part in ("normal", "friction"))
+    rows = (5 if has_jaw_forces else 4) if clamp else 3
     fig, axes = plt.subplots(rows, 1, sharex=True, figsize=(9, 2.5 * rows))
     axes[0].plot(t, columns["force_n"], label="commanded |F| (device)", lw=1.0)
     axes[0].plot(t, columns["contact_force_n"], label="proxy |F| (before safety)", lw=0.8, ls="--")
@@ -57,6 +60,14 @@ def build_figure(columns, title=""):
         axes[3].plot(t, [1e3 * v for v in columns["host_jaw_gap_m"]], lw=1.0, label="gap between the jaws (host)")
         axes[3].set_ylabel("jaw gap [mm]")
         axes[3].legend(loc="upper right", fontsize="small")
+    if has_jaw_forces:
+        # The paper's Fig. 5: the force on the grabbed object, per jaw, normal and friction parts.
+        ax = axes[4]
+        for jaw in ("a", "b"):
+            ax.plot(t, columns[f"host_jaw_{jaw}_normal_n"], lw=0.9, label=f"jaw {jaw.upper()} normal (host)")
+            ax.plot(t, columns[f"host_jaw_{jaw}_friction_n"], lw=0.9, ls="--", label=f"jaw {jaw.upper()} friction (host)")
+        ax.set_ylabel("jaw force [N]")
+        ax.legend(loc="upper right", fontsize="small")
     axes[-1].set_xlabel("time [s]")
     for ax in axes:
         ax.grid(True, alpha=0.3)

@@ -40,6 +40,10 @@ TRACE_COLUMNS = {
     "host_force_n": "N", "host_contacts": "count (int)", "host_crossed_nodes": "count (int)",
     "host_penetration_m": "m",
     "host_jaw_gap_m": "m, the jaw gap the host applied (clamp; 0 otherwise)",
+    "host_jaw_a_normal_n": "N, |normal (Hunt-Crossley) force| on jaw A (other tools: on the tool)",
+    "host_jaw_a_friction_n": "N, |friction force| on jaw A (other tools: on the tool)",
+    "host_jaw_b_normal_n": "N, |normal force| on jaw B (clamp; 0 otherwise)",
+    "host_jaw_b_friction_n": "N, |friction force| on jaw B (clamp; 0 otherwise)",
 }
 _INT_COLUMNS = {"tick", "patches_in_contact", "proxy_sequence", "fault_bits", "overruns", "host_contacts", "host_crossed_nodes"}
 

@@ -110,6 +110,12 @@ const HostStatus& SessionHost::step(DeviceStateExchange& state_in, ProxyExchange
   status_.max_penetration_m = result.crossing.max_penetration_m;
   status_.force_n = result.force_on_tool_world_n.norm();
   status_.jaw_gap_m = result.jaw_gap_m;
+  for (std::size_t part = 0; part < status_.part_normal_n.size(); ++part) {
+    const bool present = static_cast<int>(part) < result.part_count;
+    const Eigen::Vector3d& friction = result.part_results[part].friction_force_on_tool_world_n;
+    status_.part_friction_n[part] = present ? friction.norm() : 0.0;
+    status_.part_normal_n[part] = present ? (result.part_force_world_n[part] - friction).norm() : 0.0;
+  }
   status_.proxy_sequence = proxy_.sequence;
   // A closed surface's signed volume (O(faces), cheap beside the step) goes below 0 when the body
   // is turned inside out; the one-sided collision then meets no triangle and contact silently stops.

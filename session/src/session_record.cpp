@@ -62,7 +62,8 @@ SessionRecorder::SessionRecorder(const std::filesystem::path& trace_path) : trac
                "time_s,tick,tool_x_world_m,tool_y_world_m,tool_z_world_m,jaw_closing_m,"
                "force_x_device_n,force_y_device_n,force_z_device_n,force_n,contact_force_n,"
                "penetration_m,patches_in_contact,proxy_age_ms,proxy_sequence,energy_j,fade_gain,ramp_gain,"
-               "fault_bits,overruns,host_time_s,host_force_n,host_contacts,host_crossed_nodes,host_penetration_m,host_jaw_gap_m\n");
+               "fault_bits,overruns,host_time_s,host_force_n,host_contacts,host_crossed_nodes,host_penetration_m,host_jaw_gap_m,"
+               "host_jaw_a_normal_n,host_jaw_a_friction_n,host_jaw_b_normal_n,host_jaw_b_friction_n\n");
 }
 
 void SessionRecorder::note_non_finite(const char* quantity, double time_s, std::uint64_t tick) {
@@ -118,14 +119,15 @@ void SessionRecorder::add_tick(const rt::TelemetrySample& s, const HostStatus& h
   }
   if (trace_ != nullptr) {
     std::fprintf(trace_,
-                 "%.6f,%llu,%.7g,%.7g,%.7g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%u,%.4f,%llu,%.6g,%.4g,%.4g,%u,%llu,%.6f,%.6g,%d,%d,%.6g,%.6g\n",
+                 "%.6f,%llu,%.7g,%.7g,%.7g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%u,%.4f,%llu,%.6g,%.4g,%.4g,%u,%llu,%.6f,%.6g,%d,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n",
                  static_cast<double>(s.time_ns - figures_.first_tick_time_ns) * 1e-9, static_cast<unsigned long long>(s.tick), s.tool_position_world_m[0],
                  s.tool_position_world_m[1], s.tool_position_world_m[2], s.jaw_closing_m, s.force_device_n[0],
                  s.force_device_n[1], s.force_device_n[2], force, contact_force, std::max(0.0, s.max_penetration_m),
                  static_cast<unsigned>(s.patches_in_contact), age_ms, static_cast<unsigned long long>(s.proxy_sequence),
                  s.energy_j, s.fade_gain, s.ramp_gain, s.fault_bits, static_cast<unsigned long long>(s.overruns),
                  static_cast<double>(host.host_time_ns) * 1e-9, host.force_n, host.contacts, host.crossed_nodes,
-                 host.max_penetration_m, host.jaw_gap_m);
+                 host.max_penetration_m, host.jaw_gap_m, host.part_normal_n[0], host.part_friction_n[0], host.part_normal_n[1],
+                 host.part_friction_n[1]);
   }
 }
 

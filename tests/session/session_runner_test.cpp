@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <unistd.h>
 
 #include <atomic>
@@ -164,6 +166,27 @@ double column_max(const std::string& trace, const std::string& column) {
   return max;
 }
 
+/// The smallest value of a trace column (by its header name).
+double column_min(const std::string& trace, const std::string& column) {
+  std::istringstream lines(trace);
+  std::string header, row;
+  std::getline(lines, header);
+  int index = -1, at = 0;
+  std::istringstream names(header);
+  for (std::string name; std::getline(names, name, ','); ++at) {
+    if (name == column) index = at;
+  }
+  EXPECT_GE(index, 0) << column;
+  double min = std::numeric_limits<double>::infinity();
+  while (std::getline(lines, row)) {
+    std::istringstream cells(row);
+    std::string cell;
+    for (int i = 0; i <= index; ++i) std::getline(cells, cell, ',');
+    min = std::min(min, std::stod(cell));
+  }
+  return min;
+}
+
 TEST_F(SessionRunnerTest, ARecordedLockstepSessionReplaysBitForBit) {
   // Long enough for the hand to press the spatula into the ball: the replay must reproduce a
   // contact, not just a free grip.
@@ -263,6 +286,38 @@ TEST_F(SessionRunnerTest, AReplayThatCannotWorkIsRefusedBeforeTouchingEarlierOut
   fs::remove(out_ / "v9.frec");
   fs::remove_all(out_ / "recorded");
   expect_earlier_outputs_untouched();
+}
+
+/// Issue 23's grasp scenes, end to end in lockstep with the scene's own hand script: the hand
+/// closes the jaws on the vessel, lifts (or pulls) and lets go; both jaws carry a normal force and
+/// friction while the grip lasts, nothing crosses, and every output is complete.
+void expect_grasp_session(const SessionOutcome& outcome, const fs::path& out) {
+  EXPECT_EQ(outcome.trace_path, out / "trace.csv");
+  const std::string trace = read_file(out / "trace.csv");
+  const nlohmann::json summary = nlohmann::json::parse(read_file(out / "summary.json"));
+  EXPECT_EQ(summary["crossed_nodes_max"].get<int>(), 0);
+  EXPECT_EQ(summary["faults"].get<int>(), 0);
+  EXPECT_GT(column_max(trace, "host_jaw_a_normal_n"), 0.2);
+  EXPECT_GT(column_max(trace, "host_jaw_b_normal_n"), 0.2);
+  EXPECT_GT(column_max(trace, "host_jaw_a_friction_n"), 0.05) << "the grip holds by friction";
+  EXPECT_GT(column_max(trace, "host_jaw_b_friction_n"), 0.05);
+  EXPECT_LT(column_min(trace, "host_jaw_gap_m"), 0.03) << "the hand closed the jaws on the 30 mm vessel";
+}
+
+TEST_F(SessionRunnerTest, TheLiftSceneGraspsLiftsAndReleasesTheVesselEndToEnd) {
+  options_.scene = host::load_scene(host::resolve_scene_path("clamp-vessel-lift"));
+  options_.settle_s = 0.5;
+  options_.duration_s = 0.0;  // the whole hand script: close, lift, hold, lower, open
+  const SessionOutcome outcome = run_session(options_);
+  expect_grasp_session(outcome, out_);
+}
+
+TEST_F(SessionRunnerTest, TheRetractionSceneGripsAndPullsTheAnchoredVesselEndToEnd) {
+  options_.scene = host::load_scene(host::resolve_scene_path("clamp-vessel-retract"));
+  options_.settle_s = 0.5;
+  options_.duration_s = 0.0;
+  const SessionOutcome outcome = run_session(options_);
+  expect_grasp_session(outcome, out_);
 }
 
 }  // namespace

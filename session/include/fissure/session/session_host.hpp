@@ -4,6 +4,7 @@
 // device → world mapping, steps the HostSimulation there, turns the contact set into a
 // ContactProxy (host_sim's ProxyBuilder) and publishes it. Runs on the host thread in real
 // time, or interleaved with the rt ticks in lockstep.
+#include <array>
 #include <cstdint>
 
 #include "fissure/host_sim/host_simulation.hpp"
@@ -27,6 +28,10 @@ struct HostStatus {
   double force_n = 0.0;               ///< |host force on the tool| [N]
   double step_cpu_s = 0.0;            ///< wall time of the step (simulation + proxy)
   double jaw_gap_m = 0.0;             ///< clamp: gap the host applied
+  /// Per jaw (clamp: A, B; other tools: the tool in [0]): |normal (Hunt-Crossley) part| and
+  /// |friction part| of the force on it [N] (friction: in_solver with [tool] friction).
+  std::array<double, 2> part_normal_n{0.0, 0.0};
+  std::array<double, 2> part_friction_n{0.0, 0.0};
   std::uint64_t proxy_sequence = 0;
   std::uint64_t rejected_device_states = 0;  ///< non-finite samples dropped before the scene
   std::uint64_t tool_reseats = 0;     ///< device position epoch changes: tool re-seated, not swept
