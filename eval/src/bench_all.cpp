@@ -82,6 +82,8 @@ std::vector<Child> children(const fs::path& out_dir) {
       {"proxy", {"bench", "proxy"}, {}, {"--host-rates", "1000", "100"}, 5, 3},
       // Mesh import load times (issue 24): up to 362k-triangle tools; --quick stops at 41k.
       {"mesh", {"bench", "mesh"}, {}, {"--quick"}, 60, 2},
+      // Grasp, lift, slip and pull-out with friction (issue 23).
+      {"grasp", {"bench", "grasp"}, {}, {"--quick"}, 12, 10},
       {"pareto", {"bench", "pareto"}, {}, {"--quick", "--repeats", "1"}, 12, 4},
       {"view", {"bench", "view"}, {"--out", view_runs}, {"--repeats", "1", "--out", view_runs}, 25, 9},
       // The ci profile in both modes (the report carries its summary): 80-260 s on the loaded VM.

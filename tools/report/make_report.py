@@ -30,7 +30,7 @@ from targets import MET, MISSED, NOT_CHECKED, Target, evaluate_all  # noqa: E402
 
 REGENERATE = "build/bin/fissure bench all --out out/bench --docs docs --stress-full"
 
-BENCHMARKS = ["kinematics", "rt", "collision", "proxy", "pareto", "view", "stress", "stress_full", "mesh"]
+BENCHMARKS = ["kinematics", "rt", "collision", "proxy", "pareto", "view", "stress", "stress_full", "mesh", "grasp"]
 # `fissure render` children of bench all: one PNG frame each of the 10 m/s plunge.
 PLUNGE_FRAMES = {"plunge_bullet": "plunge-bullet", "plunge_paired": "plunge-paired"}
 
@@ -794,7 +794,41 @@ def section_mesh(report, data, problems, targets):
     report.add(targets_table([t for t in targets if t.section == "mesh"]))
 
 
-SECTIONS = [section_pareto, section_tunnelling, section_scaling, section_rt, section_stress, section_view, section_mesh]
+def section_grasp(report, data, problems, targets):
+    report.add("## Grasp, lift and pull-out with friction — `fissure bench grasp`")
+    report.add("")
+    grasp = data.get("grasp")
+    if not grasp:
+        missing(report, "grasp", problems)
+        return
+    report.add("The clamp closes on the soft vessel (`scenes/clamp-vessel-lift.toml`, contact inside the solver with "
+               "Coulomb friction against each node's Hunt-Crossley force), lifts it 20 mm, holds 1 s, lowers and opens; "
+               "the same at μ = 0.05; then the retraction scene's end-anchored vessel is pulled through the jaws at five "
+               "grips" + (" (a --quick run: three grips, a shorter pull)." if grasp.get("quick") else "."))
+    report.add("")
+    rows = []
+    for key, label in (("lift", "shipped μ"), ("lift_slippery", "μ 0.05")):
+        r = grasp[key]
+        rows.append([label, f"{r['friction_static_ratio']:.2f} / {r['friction_kinetic_ratio']:.2f}", fmt(1e3 * r["jaw_rise_m"]),
+                     fmt(1e3 * r["centroid_rise_m"]), fmt(1e3 * r["hold_slide_max_m"]), fmt(r["hold_grip_n"]),
+                     fmt(r["hold_friction_up_n"]), fmt(9.81 * r["vessel_mass_kg"]), fmt(1e3 * r["release_delay_s"]),
+                     r["crossed_nodes_max"], r["cut_triangles_max"]])
+    report.add(table(["lift", "μ static / kinetic", "jaws rose mm", "vessel rose mm", "max slide mm", "grip N / jaw",
+                      "friction up N", "weight N", "0 N after clearing ms", "crossed", "cut"], rows))
+    report.add("")
+    pull = grasp["pull_out"]
+    report.add(table(["jaw gap mm", "grip N / jaw", "pull-out N", "2μ·grip N", "peak N", "slid mm"],
+                     [[fmt(1e3 * r["jaw_gap_m"]), fmt(r["grip_n"]), fmt(r["pull_out_n"]), fmt(2 * pull["friction_ratio"] * r["grip_n"]),
+                       fmt(r["pull_peak_n"]), fmt(1e3 * r["slip_m"])] for r in pull["runs"]]))
+    report.add("")
+    report.add(f"Least-squares fit: pull-out = {fmt(pull['intercept_n'])} N + {fmt(pull['slope'])} × grip "
+               f"(2μ = {fmt(2 * pull['friction_ratio'])}).")
+    report.add("")
+    report.add(targets_table([t for t in targets if t.section == "grasp"]))
+
+
+SECTIONS = [section_pareto, section_tunnelling, section_scaling, section_rt, section_stress, section_view, section_mesh,
+            section_grasp]
 
 
 def main():

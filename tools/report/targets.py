@@ -421,11 +421,28 @@ def mesh_targets(mesh):
     return [Target("mesh", d[0], text, _status(exponent <= 1.1), MESH_SOURCE)]
 
 
+# ---------------------------------------------------------------- grasp (issue 23)
+
+GRASP_SOURCE = "issue 23"
+
+
+def grasp_targets(grasp):
+    """`fissure bench grasp` judges its own checks (each with its bound); the report lists them."""
+    names = ["lift: vessel rise within 2 mm of the jaws'", "lift: no node slides > 0.5 mm along a jaw during the hold",
+             "lift: 0 N within 5 ms of the jaws clearing the vessel", "lift at μ 0.05 slips out",
+             "pull-out force against grip: slope 2μ within 10 %"]
+    if grasp is None:
+        return _absent("grasp", names, GRASP_SOURCE, "no grasp.json")
+    return [Target("grasp", c["name"], f"{_f(c['value'])} (bound {_f(c['bound'])})", _status(c["pass"]), GRASP_SOURCE)
+            for c in grasp["checks"]]
+
+
 def evaluate_all(data):
     checks = [("proxy", proxy_targets, "proxy"), ("pareto", pareto_targets, "pareto"),
               ("kinematics", kinematics_targets, "kinematics"), ("collision", collision_targets, "collision"), ("contact", contact_targets, "collision"),
               ("rt", rt_targets, "rt"), ("zwidth", zwidth_targets, "rt"), ("stress", stress_targets, "stress"),
-              ("stress_full", stress_full_targets, "stress_full"), ("mesh", mesh_targets, "mesh")]
+              ("stress_full", stress_full_targets, "stress_full"), ("mesh", mesh_targets, "mesh"),
+              ("grasp", grasp_targets, "grasp")]
     out = []
     for section, function, name in checks:
         try:
