@@ -7,7 +7,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <limits>
+#include <vector>
 
 #include <unistd.h>
 
@@ -145,46 +147,38 @@ TEST_F(SessionRunnerTest, AnInterruptedSessionStillWritesCompleteOutputs) {
   }
 }
 
-/// The largest value of a trace column (by its header name).
-double column_max(const std::string& trace, const std::string& column) {
+/// Every value of a trace column (by its header name).
+std::vector<double> column(const std::string& trace, const std::string& name) {
   std::istringstream lines(trace);
   std::string header, row;
   std::getline(lines, header);
   int index = -1, at = 0;
   std::istringstream names(header);
-  for (std::string name; std::getline(names, name, ','); ++at) {
-    if (name == column) index = at;
+  for (std::string field; std::getline(names, field, ','); ++at) {
+    if (field == name) index = at;
   }
-  EXPECT_GE(index, 0) << column;
-  double max = 0.0;
+  EXPECT_GE(index, 0) << name;
+  std::vector<double> values;
+  if (index < 0) return values;
   while (std::getline(lines, row)) {
     std::istringstream cells(row);
     std::string cell;
     for (int i = 0; i <= index; ++i) std::getline(cells, cell, ',');
-    max = std::max(max, std::stod(cell));
+    values.push_back(std::stod(cell));
   }
-  return max;
+  return values;
 }
 
-/// The smallest value of a trace column (by its header name).
-double column_min(const std::string& trace, const std::string& column) {
-  std::istringstream lines(trace);
-  std::string header, row;
-  std::getline(lines, header);
-  int index = -1, at = 0;
-  std::istringstream names(header);
-  for (std::string name; std::getline(names, name, ','); ++at) {
-    if (name == column) index = at;
-  }
-  EXPECT_GE(index, 0) << column;
-  double min = std::numeric_limits<double>::infinity();
-  while (std::getline(lines, row)) {
-    std::istringstream cells(row);
-    std::string cell;
-    for (int i = 0; i <= index; ++i) std::getline(cells, cell, ',');
-    min = std::min(min, std::stod(cell));
-  }
-  return min;
+/// The largest value of a trace column (0 for an empty trace).
+double column_max(const std::string& trace, const std::string& name) {
+  const std::vector<double> v = column(trace, name);
+  return v.empty() ? 0.0 : std::max(0.0, *std::max_element(v.begin(), v.end()));
+}
+
+/// The smallest value of a trace column (+inf for an empty trace).
+double column_min(const std::string& trace, const std::string& name) {
+  const std::vector<double> v = column(trace, name);
+  return v.empty() ? std::numeric_limits<double>::infinity() : *std::min_element(v.begin(), v.end());
 }
 
 TEST_F(SessionRunnerTest, ARecordedLockstepSessionReplaysBitForBit) {
