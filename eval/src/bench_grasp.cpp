@@ -4,6 +4,7 @@
 // out, and the pull-out force grows with the grip force with slope 2μ within 10 %.
 #include "fissure/eval/bench_grasp.hpp"
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -25,6 +26,9 @@ constexpr double kSlipperyRatio = 0.05;
 constexpr double kSlippedRiseShare = 0.5;
 constexpr double kSlopeBound = 0.10;
 constexpr double kPullFrictionRatio = 0.3;
+// Drag felt: rt_core's rendered tangential force is μ·F_n within 10 % (median over the slide).
+constexpr double kDragBound = 0.10;
+constexpr std::array<double, 2> kDragHostRates_hz{1000.0, 100.0};
 
 double seconds_since(std::chrono::steady_clock::time_point t0) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); }
 
@@ -129,6 +133,37 @@ nlohmann::json run_bench_grasp(const BenchGraspOptions& options) {
   checks.push_back(check("pull-out: slope against grip / (2 mu) - 1", slope_error, kSlopeBound, std::abs(slope_error) <= kSlopeBound && grip.size() >= 3,
                          "least-squares slope of the sliding pull-out force against the per-jaw grip force"));
   checks.push_back(check("pull-out: crossed nodes", crossed, 0, crossed == 0, "paired guarantee"));
+
+  std::printf("\ndrag felt (scenes/spatula-ball-drag.toml: lockstep session, SimFalcon's hand presses the spatula onto the ball with ~2 N and\n"
+              "slides it 20 mm at 5 cm/s; the commanded force split along rt_core's contact normal, over the ticks the tool slides):\n");
+  nlohmann::json drags = nlohmann::json::array();
+  GraspDragOptions drag_options;
+  drag_options.scene = grasp_drag_scene();
+  for (const double host_rate_hz : kDragHostRates_hz) {
+    drag_options.host_rate_hz = host_rate_hz;
+    t0 = std::chrono::steady_clock::now();
+    const GraspDragResult r = run_grasp_drag(drag_options);
+    const double wall = seconds_since(t0);
+    const double host_ratio = r.host_normal_median_n > 0.0 ? r.host_friction_median_n / r.host_normal_median_n : 0.0;
+    std::printf("  host %4.0f Hz: %d slide ticks at %.1f cm/s, normal %.3f N, tangential %.3f N: ratio median %.4f (p10 %.4f, p90 %.4f) vs mu_k %.2f;\n"
+                "    cone sliding on %.0f %% of them; host's own friction %.3f N on %.3f N normal (%.3f); max |dF|/tick %.4f N, observer max %.4f J, crossed %d; %.1f s\n",
+                host_rate_hz, r.slide_ticks, r.slide_speed_median_m_per_s * 1e2, r.normal_median_n, r.tangential_median_n, r.ratio_median, r.ratio_p10,
+                r.ratio_p90, r.friction_kinetic_ratio, 100.0 * r.sliding_tick_share, r.host_friction_median_n, r.host_normal_median_n, host_ratio,
+                r.max_force_step_n, r.energy_max_j, r.crossed_nodes_max, wall);
+    drags.push_back({{"host_rate_hz", host_rate_hz}, {"friction_static_ratio", r.friction_static_ratio},
+                     {"friction_kinetic_ratio", r.friction_kinetic_ratio}, {"slide_ticks", r.slide_ticks},
+                     {"slide_speed_median_m_per_s", r.slide_speed_median_m_per_s}, {"normal_median_n", r.normal_median_n},
+                     {"tangential_median_n", r.tangential_median_n}, {"ratio_median", r.ratio_median}, {"ratio_p10", r.ratio_p10},
+                     {"ratio_p90", r.ratio_p90}, {"sliding_tick_share", r.sliding_tick_share}, {"host_friction_median_n", r.host_friction_median_n},
+                     {"host_normal_median_n", r.host_normal_median_n}, {"max_force_step_n", r.max_force_step_n}, {"energy_max_j", r.energy_max_j},
+                     {"crossed_nodes_max", r.crossed_nodes_max}, {"finite", r.finite}, {"wall_s", wall}});
+    const double error = r.friction_kinetic_ratio > 0.0 ? r.ratio_median / r.friction_kinetic_ratio - 1.0 : 1.0;
+    char name[96];
+    std::snprintf(name, sizeof name, "drag at host %.0f Hz: rendered tangential / (mu_k F_n) - 1", host_rate_hz);
+    checks.push_back(check(name, error, kDragBound, std::abs(error) <= kDragBound && r.slide_ticks > 0 && r.finite,
+                           "median over the slide of the commanded force's tangential / normal part, against mu_k"));
+  }
+  out["drag"] = drags;
   out["checks"] = checks;
   return out;
 }

@@ -31,6 +31,12 @@ ProxyBuilder::ProxyBuilder(const ProxyBuilderModel& model) : model_(model) {
   if (!(model.hunt_crossley.k >= 0.0) || !(model.hunt_crossley.lambda >= 0.0)) {
     throw std::invalid_argument("proxy builder: Hunt-Crossley k and lambda must be >= 0");
   }
+  if (!(model.friction_static_ratio >= 0.0 && model.friction_static_ratio <= ProxyLimits::kMaxFrictionRatio) ||
+      !(model.friction_kinetic_ratio >= 0.0 && model.friction_kinetic_ratio <= model.friction_static_ratio)) {
+    throw std::invalid_argument("proxy builder: friction ratios must satisfy 0 <= kinetic <= static <= 2, got static " +
+                                std::to_string(model.friction_static_ratio) + ", kinetic " +
+                                std::to_string(model.friction_kinetic_ratio));
+  }
   int total = 0;
   for (int jaw = 0; jaw < model.jaw_count; ++jaw) {
     const auto j = static_cast<std::size_t>(jaw);
@@ -120,6 +126,28 @@ const ProxyBuildReport& ProxyBuilder::build(const std::vector<ContactRecord>& co
   }
   out.patch_count = count;
   if (count > 0) out.flags |= kProxyHostInContact;
+  // Friction for each part a patch pushes (rt_core renders none where no patch is).
+  if (model_.friction_static_ratio > 0.0) {
+    for (std::uint16_t i = 0; i < count; ++i) {
+      const ToolPart part = out.patches[i].tool_part;
+      const auto p = static_cast<std::size_t>(part);
+      if ((out.flags & proxy_friction_bit(part)) != 0u) continue;
+      out.flags |= proxy_friction_bit(part);
+      PartFriction& friction = out.friction[p];
+      Eigen::Vector3d force = parts.friction_force_world_n[p];
+      // Keep it inside what rt_core accepts (message_validation.hpp): only a host bug gets there.
+      if (!force.allFinite()) force.setZero();
+      if (force.norm() > ProxyLimits::kMaxFrictionForce_n) force *= ProxyLimits::kMaxFrictionForce_n / force.norm();
+      friction.host_force_world_n = to_vec3(force);
+      friction.reference_part_position_world_m = to_vec3(parts.p_world_m[p]);
+      Eigen::Vector3d surface_velocity = parts.surface_velocity_world_m_per_s[p];
+      if (!surface_velocity.allFinite()) surface_velocity.setZero();
+      friction.surface_velocity_world_m_per_s =
+          to_vec3(surface_velocity.cwiseMax(-ProxyLimits::kMaxSurfaceSpeed_m_per_s).cwiseMin(ProxyLimits::kMaxSurfaceSpeed_m_per_s));
+      friction.static_ratio = model_.friction_static_ratio;
+      friction.kinetic_ratio = model_.friction_kinetic_ratio;
+    }
+  }
   return report_;
 }
 

@@ -11,6 +11,8 @@ namespace fissure::host {
 std::optional<ProxyBuilderModel> proxy_model_for(const SceneDescription& scene, const HostSimulation& sim) {
   ProxyBuilderModel model;
   model.hunt_crossley = scene.hunt_crossley;
+  model.friction_static_ratio = scene.tool.friction_static_ratio;
+  model.friction_kinetic_ratio = scene.tool.friction_kinetic_ratio;
   const bool clamp = scene.tool.kind == ToolKind::kClamp;
   model.jaw_count = clamp ? 2 : 1;
   // rt_core's clamp convention (shared/device_mapping.hpp): jaw A is the one on the −e_c side.

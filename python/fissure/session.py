@@ -44,8 +44,11 @@ TRACE_COLUMNS = {
     "host_jaw_a_friction_n": "N, |friction force| on jaw A (other tools: on the tool)",
     "host_jaw_b_normal_n": "N, |normal force| on jaw B (clamp; 0 otherwise)",
     "host_jaw_b_friction_n": "N, |friction force| on jaw B (clamp; 0 otherwise)",
+    "friction_n": "N, |friction share of the proxy force| rt_core rendered (device frame, faded)",
+    "parts_sliding": "count (int): tool parts whose friction cone slides",
 }
-_INT_COLUMNS = {"tick", "patches_in_contact", "proxy_sequence", "fault_bits", "overruns", "host_contacts", "host_crossed_nodes"}
+_INT_COLUMNS = {"tick", "patches_in_contact", "proxy_sequence", "fault_bits", "overruns", "host_contacts", "host_crossed_nodes",
+                "parts_sliding"}
 
 
 def read_trace(path: Union[str, os.PathLike]) -> Dict[str, np.ndarray]:

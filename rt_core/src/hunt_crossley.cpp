@@ -24,8 +24,9 @@ double hunt_crossley_force_n(double x, double x_dot, double k, double lambda, do
 }
 
 ContactEvaluation evaluate_proxy(const ContactProxy& proxy, const DeviceMapping& mapping, const ToolState& tool,
-                                 PartForces& forces, const DampingCap& cap) noexcept {
+                                 PartForces& forces, const DampingCap& cap, PartNormalLoad* load) noexcept {
   forces.clear();
+  if (load != nullptr) *load = PartNormalLoad{};
   ContactEvaluation evaluation;
   evaluation.max_penetration_m = -1.0;  // "no patch": any real penetration is larger
   const int count = std::min<int>(proxy.patch_count, static_cast<int>(kMaxContactPatches));
@@ -47,6 +48,10 @@ ContactEvaluation evaluate_proxy(const ContactProxy& proxy, const DeviceMapping&
     const double max_damping = std::max(0.0, cap.device_damping_world_n_s_per_m - 0.5 * tangent_stiffness * cap.period_s);
     const double lambda = std::min(patch.damping_lambda, max_damping / x_n);
     forces.force_world_n[part_index] += std::max(0.0, k * x_n + lambda * x_n * x_dot) * normal;
+    if (load != nullptr) {
+      load->elastic_force_world_n[part_index] += k * x_n * normal;
+      load->elastic_sum_n[part_index] += k * x_n;
+    }
     evaluation.stored_energy_world_j += k * x_n * x / (n + 1.0);
     ++evaluation.patches_in_contact;
   }

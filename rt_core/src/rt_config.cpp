@@ -1,5 +1,6 @@
 #include "fissure/rt_core/rt_config.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -35,6 +36,12 @@ const char* check_config(const RtConfig& c) noexcept {
   if (!positive(c.proxy.blend_max_step_n)) return "proxy.blend_max_step_n must be > 0";
   if (!positive(c.proxy.stale_after_s)) return "proxy.stale_after_s must be > 0";
   if (!non_negative(c.proxy.fade_s)) return "proxy.fade_s must be ≥ 0";
+  if (!(non_negative(c.friction.stick_stiffness_device_n_per_m) &&
+        c.friction.stick_stiffness_device_n_per_m <= kFalconMaxStiffness_n_per_m)) {
+    return "friction.stick_stiffness_device_n_per_m must be in [0, 3000] N/m (the Falcon's rated stiffness)";
+  }
+  if (!positive(c.friction.host_follow_s)) return "friction.host_follow_s must be > 0";
+  if (!positive(c.friction.max_step_n)) return "friction.max_step_n must be > 0";
   if (!non_negative(c.passivity.max_damping_n_s_per_m)) return "passivity.max_damping_n_s_per_m must be ≥ 0";
   if (!positive(c.passivity.min_speed_m_per_s)) return "passivity.min_speed_m_per_s must be > 0";
   if (!positive(c.passivity.margin_j)) return "passivity.margin_j must be > 0";
@@ -81,6 +88,16 @@ bool build_model(const RtConfig& config, RtModel& model, const char** error) noe
                                                          : std::numeric_limits<double>::infinity();
   model.damping_cap.period_s = model.period_s;
   model.device_energy_per_world_energy = config.mapping.force_scale / config.mapping.scale;
+  // A world spring K renders force_scale·scale·K at the device (as the damping above).
+  model.friction.stick_stiffness_world_n_per_m =
+      world_per_device_damping > 0.0 ? config.friction.stick_stiffness_device_n_per_m / world_per_device_damping : 0.0;
+  model.friction.walk_share = std::min(1.0, model.period_s / config.friction.host_follow_s);
+  // max_step_n at the device is max_step_n / force_scale in the world; over K_t, a length.
+  model.friction.max_walk_m = model.friction.stick_stiffness_world_n_per_m > 0.0 && config.mapping.force_scale > 0.0
+                                  ? config.friction.max_step_n / config.mapping.force_scale /
+                                        model.friction.stick_stiffness_world_n_per_m
+                                  : 0.0;
+  model.friction.period_s = model.period_s;
   return true;
 }
 

@@ -167,25 +167,36 @@ TickResult tick(const RtModel& model, RtData& data, TickIo& io, const TickTiming
     data.max_penetration_m = -1.0;
     data.patches_in_contact = 0;
     double stored_energy_j = 0.0;
+    data.friction_force_device_n.setZero();
+    data.parts_sliding = 0;
     if (data.proxy.have_proxy) {
-      const ContactEvaluation evaluation =
-          evaluate_proxy(active_proxy(data.proxy), config.mapping, data.tool, data.part_forces, model.damping_cap);
+      const ContactEvaluation evaluation = evaluate_proxy(active_proxy(data.proxy), config.mapping, data.tool,
+                                                          data.part_forces, model.damping_cap, &data.normal_load);
       data.max_penetration_m = evaluation.max_penetration_m;
       data.patches_in_contact = evaluation.patches_in_contact;
-      new_force = part_forces_to_device(config.mapping, data.part_forces);
-      // The staleness fade and safety's ramp scale the rendered spring, and with it what it stores.
+      const FrictionEvaluation friction =
+          evaluate_friction(model.friction, data.friction, active_proxy(data.proxy), data.normal_load, config.mapping, data.tool);
+      data.friction_force_device_n = part_forces_to_device(config.mapping, friction.force_world_n);
+      data.parts_sliding = friction.parts_sliding;
+      new_force = part_forces_to_device(config.mapping, data.part_forces) + data.friction_force_device_n;
+      // The staleness fade and safety's ramp scale the rendered springs (normal and stick), and
+      // with them what they store.
       stored_energy_j = fade_gain * data.safety.ramp_gain * model.device_energy_per_world_energy *
-                        evaluation.stored_energy_world_j;
+                        (evaluation.stored_energy_world_j + friction.stored_energy_world_j);
+    } else {
+      data.friction = FrictionState{};
     }
     if (history_break) {
       // A proxy accepted in this tick is the one in use: the force it gives here is what the
       // blend walks to; the one it replaces is as stale as the rest (proxy_blend.hpp).
       continue_after_break(data.blend, new_force);
     } else if (intake == ProxyIntake::kAccepted) {
-      Eigen::Vector3d old_force = Eigen::Vector3d::Zero();  // the first proxy blends in from zero
+      Eigen::Vector3d old_force = data.friction_force_device_n;  // the first proxy blends its normal force in from zero
       if (data.proxy.have_previous) {
+        // Friction is continuous by its own construction (friction_cone.hpp: the anchor walks
+        // towards the host's state at a bounded rate), so the swap blends the normal forces only.
         evaluate_proxy(previous_proxy(data.proxy), config.mapping, data.tool, data.part_forces, model.damping_cap);
-        old_force = part_forces_to_device(config.mapping, data.part_forces);
+        old_force = part_forces_to_device(config.mapping, data.part_forces) + data.friction_force_device_n;
       }
       begin_swap(data.blend, old_force, new_force);
     }
@@ -254,6 +265,8 @@ TickResult tick(const RtModel& model, RtData& data, TickIo& io, const TickTiming
   sample.velocity_device_m_per_s = state.velocity_device_m_per_s;
   sample.tool_position_world_m = to_vec3(data.tool.p_tool_world_m);
   sample.contact_force_device_n = to_vec3(data.contact_force_device_n);
+  sample.friction_force_device_n = to_vec3(fade_gain * data.friction_force_device_n);
+  sample.parts_sliding = static_cast<std::uint8_t>(data.parts_sliding);
   sample.force_device_n = to_vec3(data.force_device_n);
   sample.motor_counts = data.pending_command.motor_counts;
   sample.patches_in_contact = static_cast<std::uint16_t>(data.patches_in_contact);

@@ -2,6 +2,7 @@
 
 #include "fissure/shared/message_validation.hpp"
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -28,6 +29,35 @@ host::ProxyBuilderModel session_proxy_model(const host::SceneDescription& scene,
                                 "': fissure run needs the paired or ray collision method (the proxy is built from its contacts)");
   }
   return *model;
+}
+
+// rt_core's friction cone needs, per tool part, the host's friction force on it and the velocity
+// of the tissue under it (messages.hpp, PartFriction): the contacted triangles' node velocities,
+// weighted by each triangle's contact force.
+void add_friction_inputs(const host::HostStepResult& result, const host::ProxyBuilderModel& model, const btSoftBody& soft,
+                         host::ProxyPartMotion& parts) {
+  std::array<double, 3> weight_n{0.0, 0.0, 0.0};
+  std::array<Eigen::Vector3d, 3> weighted{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  for (int jaw = 0; jaw < result.part_count && jaw < model.jaw_count; ++jaw) {
+    const auto j = static_cast<std::size_t>(jaw);
+    parts.friction_force_world_n[static_cast<std::size_t>(model.part_of_jaw[j])] += result.part_results[j].friction_force_on_tool_world_n;
+  }
+  for (int i = 0; i < result.contact_count && i < static_cast<int>(result.contacts.size()); ++i) {
+    const host::ContactRecord& record = result.contacts[static_cast<std::size_t>(i)];
+    if (record.jaw < 0 || record.jaw >= model.jaw_count || record.soft_face < 0 || record.soft_face >= soft.m_faces.size() ||
+        !(record.force_n > 0.0)) {
+      continue;
+    }
+    const btSoftBody::Face& face = soft.m_faces[record.soft_face];
+    Eigen::Vector3d v = Eigen::Vector3d::Zero();
+    for (const btSoftBody::Node* node : face.m_n) v += Eigen::Vector3d(node->m_v.x(), node->m_v.y(), node->m_v.z()) / 3.0;
+    const auto part = static_cast<std::size_t>(model.part_of_jaw[static_cast<std::size_t>(record.jaw)]);
+    weighted[part] += record.force_n * v;
+    weight_n[part] += record.force_n;
+  }
+  for (std::size_t part = 0; part < weighted.size(); ++part) {
+    if (weight_n[part] > 0.0) parts.surface_velocity_world_m_per_s[part] = weighted[part] / weight_n[part];
+  }
 }
 
 }  // namespace
@@ -98,6 +128,8 @@ const HostStatus& SessionHost::step(DeviceStateExchange& state_in, ProxyExchange
     parts.p_world_m[static_cast<std::size_t>(part)] = motion.p_world_m;
     parts.v_world_m_per_s[static_cast<std::size_t>(part)] = motion.v_world_m_per_s;
   }
+  const host::ProxyBuilderModel& proxy_model = builder_.model();
+  if (proxy_model.friction_static_ratio > 0.0) add_friction_inputs(result, proxy_model, sim_.world().soft(), parts);
   const auto host_time_ns = static_cast<TimeNs>(std::llround(result.time_s * 1e9));
   builder_.build(result.contacts, pose_, parts, host_time_ns, proxy_);
   proxy_out.publish(proxy_);

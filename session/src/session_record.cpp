@@ -23,6 +23,7 @@ const char* non_finite_quantity(const rt::TelemetrySample& s) {
   if (!std::isfinite(s.jaw_closing_m)) return "jaw closing (jaw_closing_m)";
   if (!finite(s.force_device_n)) return "commanded device force (force_*_device_n)";
   if (!finite(s.contact_force_device_n)) return "contact force (contact_force_n)";
+  if (!finite(s.friction_force_device_n)) return "friction force (friction_n)";
   if (!std::isfinite(s.max_penetration_m)) return "rt penetration depth (penetration_m)";
   if (!std::isfinite(s.energy_j)) return "passivity energy (energy_j)";
   if (!std::isfinite(s.fade_gain) || !std::isfinite(s.ramp_gain)) return "force gains (fade_gain, ramp_gain)";
@@ -63,7 +64,7 @@ SessionRecorder::SessionRecorder(const std::filesystem::path& trace_path) : trac
                "force_x_device_n,force_y_device_n,force_z_device_n,force_n,contact_force_n,"
                "penetration_m,patches_in_contact,proxy_age_ms,proxy_sequence,energy_j,fade_gain,ramp_gain,"
                "fault_bits,overruns,host_time_s,host_force_n,host_contacts,host_crossed_nodes,host_penetration_m,host_jaw_gap_m,"
-               "host_jaw_a_normal_n,host_jaw_a_friction_n,host_jaw_b_normal_n,host_jaw_b_friction_n\n");
+               "host_jaw_a_normal_n,host_jaw_a_friction_n,host_jaw_b_normal_n,host_jaw_b_friction_n,friction_n,parts_sliding\n");
 }
 
 void SessionRecorder::note_non_finite(const char* quantity, double time_s, std::uint64_t tick) {
@@ -119,7 +120,7 @@ void SessionRecorder::add_tick(const rt::TelemetrySample& s, const HostStatus& h
   }
   if (trace_ != nullptr) {
     std::fprintf(trace_,
-                 "%.6f,%llu,%.7g,%.7g,%.7g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%u,%.4f,%llu,%.6g,%.4g,%.4g,%u,%llu,%.6f,%.6g,%d,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n",
+                 "%.6f,%llu,%.7g,%.7g,%.7g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%u,%.4f,%llu,%.6g,%.4g,%.4g,%u,%llu,%.6f,%.6g,%d,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%u\n",
                  static_cast<double>(s.time_ns - figures_.first_tick_time_ns) * 1e-9, static_cast<unsigned long long>(s.tick), s.tool_position_world_m[0],
                  s.tool_position_world_m[1], s.tool_position_world_m[2], s.jaw_closing_m, s.force_device_n[0],
                  s.force_device_n[1], s.force_device_n[2], force, contact_force, std::max(0.0, s.max_penetration_m),
@@ -127,7 +128,7 @@ void SessionRecorder::add_tick(const rt::TelemetrySample& s, const HostStatus& h
                  s.energy_j, s.fade_gain, s.ramp_gain, s.fault_bits, static_cast<unsigned long long>(s.overruns),
                  static_cast<double>(host.host_time_ns) * 1e-9, host.force_n, host.contacts, host.crossed_nodes,
                  host.max_penetration_m, host.jaw_gap_m, host.part_normal_n[0], host.part_friction_n[0], host.part_normal_n[1],
-                 host.part_friction_n[1]);
+                 host.part_friction_n[1], norm(s.friction_force_device_n), static_cast<unsigned>(s.parts_sliding));
   }
 }
 

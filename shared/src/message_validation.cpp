@@ -34,6 +34,20 @@ ProxyError validate_patch(const ContactPatch& p) noexcept {
   return ProxyError::kNone;
 }
 
+ProxyError validate_friction(const PartFriction& f) noexcept {
+  if (!finite3(f.host_force_world_n) || !finite3(f.reference_part_position_world_m) ||
+      !finite3(f.surface_velocity_world_m_per_s) || !std::isfinite(f.static_ratio) || !std::isfinite(f.kinetic_ratio)) {
+    return ProxyError::kNonFinite;
+  }
+  if (f.static_ratio < 0.0 || f.static_ratio > ProxyLimits::kMaxFrictionRatio || f.kinetic_ratio < 0.0 ||
+      f.kinetic_ratio > f.static_ratio || as_eigen(f.host_force_world_n).norm() > ProxyLimits::kMaxFrictionForce_n ||
+      !within(f.reference_part_position_world_m, ProxyLimits::kMaxCoordinate_m) ||
+      !within(f.surface_velocity_world_m_per_s, ProxyLimits::kMaxSurfaceSpeed_m_per_s)) {
+    return ProxyError::kFrictionOutOfRange;
+  }
+  return ProxyError::kNone;
+}
+
 }  // namespace
 
 const char* to_string(ProxyError error) noexcept {
@@ -48,6 +62,7 @@ const char* to_string(ProxyError error) noexcept {
     case ProxyError::kDampingOutOfRange: return "damping lambda out of range";
     case ProxyError::kExponentOutOfRange: return "exponent n out of range";
     case ProxyError::kBadToolPart: return "unknown tool part";
+    case ProxyError::kFrictionOutOfRange: return "part friction out of range (ratio outside [0, 2], kinetic above static, force or position too large)";
   }
   return "unknown proxy error";
 }
@@ -62,6 +77,11 @@ ProxyError validate(const ContactProxy& proxy, int* bad_patch) noexcept {
       if (bad_patch != nullptr) *bad_patch = i;
       return error;
     }
+  }
+  for (std::size_t part = 0; part < proxy.friction.size(); ++part) {
+    if ((proxy.flags & proxy_friction_bit(static_cast<ToolPart>(part))) == 0u) continue;
+    const ProxyError error = validate_friction(proxy.friction[part]);
+    if (error != ProxyError::kNone) return error;
   }
   return ProxyError::kNone;
 }

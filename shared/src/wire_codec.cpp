@@ -213,6 +213,15 @@ EncodeStatus encode(const ContactProxy& proxy, std::uint8_t transfer_id, FrameBa
     writer.i64(patch.reference_time_ns);
     writer.u8(static_cast<std::uint8_t>(static_cast<std::uint32_t>(patch.tool_part) | orientation_bits));
   }
+  for (std::size_t part = 0; part < proxy.friction.size(); ++part) {
+    if ((proxy.flags & proxy_friction_bit(static_cast<ToolPart>(part))) == 0u) continue;
+    const PartFriction& friction = proxy.friction[part];
+    writer.vec3(friction.host_force_world_n);
+    writer.vec3(friction.reference_part_position_world_m);
+    writer.vec3(friction.surface_velocity_world_m_per_s);
+    writer.u16(friction_ratio_to_wire(friction.static_ratio));
+    writer.u16(friction_ratio_to_wire(friction.kinetic_ratio));
+  }
   const std::size_t message_bytes = writer.size() + kCrcBytes;
   segment(static_cast<std::uint8_t>(kProtocolVersion), MessageType::kContactProxy, transfer_id, message.data(),
           message_bytes, out);
@@ -266,10 +275,11 @@ std::size_t message_bytes_for(MessageType type, const std::uint8_t* message, std
     case MessageType::kDeviceState: return kDeviceStateMessageBytes;
     case MessageType::kContactProxy: {
       constexpr std::size_t kPatchCountOffset = 16;
-      if (available <= kPatchCountOffset) return 0;
+      constexpr std::size_t kFlagsOffset = 17;
+      if (available <= kFlagsOffset) return 0;
       const std::size_t patch_count = message[kPatchCountOffset];
       if (patch_count > kMaxContactPatches) return 0;
-      return proxy_message_bytes(patch_count);
+      return proxy_message_bytes(patch_count, friction_parts_in(message[kFlagsOffset]));
     }
     case MessageType::kNone: break;
   }
@@ -323,6 +333,18 @@ void decode_contact_proxy(const std::uint8_t* message, ContactProxy& out) noexce
     patch.reference_tool_orientation_world = read_orientation(orientation_reader, part_byte);
     patch.tool_part = static_cast<ToolPart>(part_byte & kPartMask);
     patch.reserved = 0;
+  }
+  for (std::size_t part = 0; part < out.friction.size(); ++part) {
+    PartFriction& friction = out.friction[part];
+    if ((out.flags & proxy_friction_bit(static_cast<ToolPart>(part))) == 0u) {
+      friction = PartFriction{};  // absent parts read as defaults, never as stale data
+      continue;
+    }
+    friction.host_force_world_n = reader.vec3();
+    friction.reference_part_position_world_m = reader.vec3();
+    friction.surface_velocity_world_m_per_s = reader.vec3();
+    friction.static_ratio = friction_ratio_from_wire(reader.u16());
+    friction.kinetic_ratio = friction_ratio_from_wire(reader.u16());
   }
 }
 

@@ -113,20 +113,31 @@ TEST(RtLoop, NoHeapAllocationInTenToTheFiveTicks) {
   trace.reserve(1);
   TelemetrySample sample;
   double max_force = 0.0;
+  double max_friction = 0.0;
+  bool slid = false;
   std::uint64_t popped = 0;
 
   g_allocations = 0;
   g_counting = true;
   constexpr int kTicks = 100'000;
   for (int k = 0; k < kTicks; ++k) {
-    if (k % 10 == 0) {  // a 100 Hz host: plane drifts, HC parameters as for tissue
-      s.proxy_in.publish(plane_proxy(static_cast<std::uint64_t>(k / 10 + 1), {0.0, -0.004 - 1e-6 * (k % 1000), 0.0},
-                                     {0.0, 1.0, 0.0}, 10000.0, 2000.0, 1.5));
+    if (k % 10 == 0) {  // a 100 Hz host: plane drifts, HC parameters as for tissue, friction on
+      ContactProxy proxy = plane_proxy(static_cast<std::uint64_t>(k / 10 + 1), {0.0, -0.004 - 1e-6 * (k % 1000), 0.0},
+                                       {0.0, 1.0, 0.0}, 10000.0, 2000.0, 1.5);
+      proxy.flags |= proxy_friction_bit(ToolPart::kTool);
+      // A host that slides: its friction opposes the tool's motion, seen where the tool was.
+      proxy.friction[0].reference_part_position_world_m = to_vec3(s.loop->data().tool.p_tool_world_m);
+      proxy.friction[0].host_force_world_n = to_vec3(-5.0 * s.loop->data().tool.v_tool_world_m_per_s);
+      proxy.friction[0].static_ratio = 0.5;
+      proxy.friction[0].kinetic_ratio = 0.4;
+      s.proxy_in.publish(proxy);
     }
     s.loop->step();
     while (s.telemetry->try_pop(sample)) {
       ++popped;
       max_force = std::max(max_force, as_eigen(sample.force_device_n).norm());
+      max_friction = std::max(max_friction, as_eigen(sample.friction_force_device_n).norm());
+      slid = slid || sample.parts_sliding > 0;
     }
   }
   g_counting = false;
@@ -134,6 +145,8 @@ TEST(RtLoop, NoHeapAllocationInTenToTheFiveTicks) {
   EXPECT_EQ(s.loop->stats().ticks, static_cast<std::uint64_t>(kTicks));
   EXPECT_EQ(popped, static_cast<std::uint64_t>(kTicks));
   EXPECT_GT(max_force, 1.0);  // it really rendered contact
+  EXPECT_GT(max_friction, 0.1);  // and friction, sticking and sliding
+  EXPECT_TRUE(slid);
   EXPECT_EQ(s.loop->data().faults.fault_ticks, 0u);
 }
 

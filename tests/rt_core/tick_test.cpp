@@ -75,6 +75,71 @@ TEST(Tick, RendersHuntCrossleyAtTheCurrentPositionAfterTheRampIn) {
   EXPECT_NEAR(h.last_sample.max_penetration_m, kPlaneY_m - h.data.p_device_m.y(), 1e-15);
 }
 
+TEST(Tick, RendersTheProxysFrictionConeAtTheHandAndReportsIt) {
+  // The hand is put inside the wall (StillDevice) instead of pressing into it, so the observer
+  // never saw the work that loaded the wall's spring and would owe it back; the passivity
+  // controller is off to see the friction stage alone (rt_loop_test runs it closed loop).
+  RtConfig config;
+  config.passivity.enabled = false;
+  Harness h(config);
+  constexpr double kMuStatic = 0.5, kMuKinetic = 0.4;
+  // A host that agrees with rt_core: its friction is what the hand was last rendered, where the
+  // hand was last published (identity mapping: world = device).
+  Eigen::Vector3d hand = kCentre_device_m;
+  const auto publish = [&h, &hand] {
+    ContactProxy proxy = plane_proxy(++h.sequence, {0.0, kPlaneY_m, 0.0}, {0.0, 1.0, 0.0}, kStiffness_n_per_m);
+    proxy.flags |= proxy_friction_bit(ToolPart::kTool);
+    PartFriction& friction = proxy.friction[0];
+    friction.host_force_world_n = h.last_sample.friction_force_device_n;
+    // The position the last DeviceState published (what a host steps to), before any: the hand.
+    friction.reference_part_position_world_m = to_vec3(h.data.have_position ? h.data.p_device_m : hand);
+    friction.static_ratio = kMuStatic;
+    friction.kinetic_ratio = kMuKinetic;
+    h.proxy_in.publish(proxy);
+  };
+  for (int i = 0; i < 700; ++i) {
+    publish();
+    h.step();
+  }
+  const double anchor_x = h.data.tool.p_tool_world_m.x();
+  // The first proxy's reference is the hand's target, a fraction of a count from the reading.
+  const double resting_n = h.last_sample.friction_force_device_n[0];
+  EXPECT_LT(as_eigen(h.last_sample.friction_force_device_n).norm(), 0.005) << "a resting hand feels no friction";
+  // 0.3 mm sideways: stuck, the stick spring pulls back (0.3 N < μ_s·2.5 N).
+  hand = kCentre_device_m + Eigen::Vector3d(3e-4, 0.0, 0.0);
+  h.device.place(hand);
+  for (int i = 0; i < 100; ++i) {
+    publish();
+    h.step();
+  }
+  const double stretch_m = h.data.tool.p_tool_world_m.x() - anchor_x;
+  ASSERT_GT(stretch_m, 1e-4);
+  const double stick_n = resting_n - kDefaultFrictionStickStiffness_n_per_m * stretch_m;
+  EXPECT_NEAR(h.last_sample.friction_force_device_n[0], stick_n, 1e-3);
+  EXPECT_NEAR(h.data.force_device_n.x(), h.last_sample.friction_force_device_n[0], 1e-6);
+  EXPECT_EQ(h.last_sample.parts_sliding, 0);
+  // 3 mm further at 3 cm/s: past the cone, it slides; stopped there, it holds μ_k times the
+  // normal force.
+  bool slid = false;
+  for (int i = 1; i <= 100; ++i) {
+    hand = kCentre_device_m + Eigen::Vector3d(3e-4 + 3e-5 * i, 0.0, 0.0);
+    h.device.place(hand);
+    publish();
+    h.step();
+    slid = slid || h.last_sample.parts_sliding == 1;
+  }
+  EXPECT_TRUE(slid);
+  for (int i = 0; i < 100; ++i) {
+    publish();
+    h.step();
+  }
+  const double normal_n = kStiffness_n_per_m * (kPlaneY_m - h.data.tool.p_tool_world_m.y());
+  EXPECT_NEAR(h.last_sample.friction_force_device_n[0], -kMuKinetic * normal_n, 0.005 * normal_n);
+  EXPECT_NEAR(h.data.force_device_n.x(), h.last_sample.friction_force_device_n[0], 1e-6);
+  EXPECT_NEAR(h.data.force_device_n.y(), normal_n, 1e-6);
+  EXPECT_EQ(h.last_sample.parts_sliding, 0);
+}
+
 TEST(Tick, CommandGoesOutWithTheNextExchange) {
   Harness h;
   h.settle();

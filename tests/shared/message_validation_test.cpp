@@ -22,6 +22,47 @@ ContactProxy one_patch_proxy() {
   return proxy;
 }
 
+ContactProxy proxy_with_friction() {
+  ContactProxy proxy = one_patch_proxy();
+  proxy.flags |= proxy_friction_bit(ToolPart::kTool);
+  PartFriction& f = proxy.friction[0];
+  f.host_force_world_n = {0.3, 0.0, -0.1};
+  f.reference_part_position_world_m = {0.0, 0.1, 0.0};
+  f.surface_velocity_world_m_per_s = {0.01, 0.0, 0.0};
+  f.static_ratio = 0.5;
+  f.kinetic_ratio = 0.4;
+  return proxy;
+}
+
+TEST(MessageValidation, PartFrictionIsCheckedOnlyWhereItsFlagSaysItIsCarried) {
+  EXPECT_EQ(validate(proxy_with_friction()), ProxyError::kNone);
+  struct Case {
+    const char* what;
+    void (*corrupt)(PartFriction&);
+    ProxyError expected;
+  };
+  const Case cases[] = {
+      {"nan force", [](PartFriction& f) { f.host_force_world_n[1] = std::numeric_limits<double>::quiet_NaN(); }, ProxyError::kNonFinite},
+      {"inf velocity", [](PartFriction& f) { f.surface_velocity_world_m_per_s[0] = std::numeric_limits<double>::infinity(); }, ProxyError::kNonFinite},
+      {"negative mu", [](PartFriction& f) { f.static_ratio = -0.1; }, ProxyError::kFrictionOutOfRange},
+      {"mu above 2", [](PartFriction& f) { f.static_ratio = 2.5; }, ProxyError::kFrictionOutOfRange},
+      {"kinetic above static", [](PartFriction& f) { f.kinetic_ratio = 0.6; }, ProxyError::kFrictionOutOfRange},
+      {"absurd force", [](PartFriction& f) { f.host_force_world_n[0] = 1e4; }, ProxyError::kFrictionOutOfRange},
+      {"far reference", [](PartFriction& f) { f.reference_part_position_world_m[2] = 50.0; }, ProxyError::kFrictionOutOfRange},
+      {"absurd surface speed", [](PartFriction& f) { f.surface_velocity_world_m_per_s[1] = 500.0; }, ProxyError::kFrictionOutOfRange},
+  };
+  for (const Case& c : cases) {
+    ContactProxy proxy = proxy_with_friction();
+    c.corrupt(proxy.friction[0]);
+    EXPECT_EQ(validate(proxy), c.expected) << c.what;
+    EXPECT_STRNE(to_string(c.expected), "unknown proxy error");
+    // The same garbage in a part whose flag is clear is not read.
+    ContactProxy unflagged = one_patch_proxy();
+    unflagged.friction[0] = proxy.friction[0];
+    EXPECT_EQ(validate(unflagged), ProxyError::kNone) << c.what;
+  }
+}
+
 TEST(MessageLayout, ProxyIsByteCopyable) {
   const ContactProxy a = one_patch_proxy();
   ContactProxy b;

@@ -67,9 +67,10 @@ TEST(UdpCarrier, ProxyAndDeviceStateRoundTripOverLoopbackUdp) {
 
   LinkSender host_sender(talker);
   LinkReceiver rt_receiver(listener, clock);
-  const ContactProxy sent = test::make_proxy(77, kMaxContactPatches);
+  // A clamp's full proxy with both jaws' friction: the largest message the shipped tools send.
+  const ContactProxy sent = test::make_proxy(77, kMaxContactPatches, 0b110);
   ASSERT_EQ(host_sender.publish(sent), wire::EncodeStatus::kOk);
-  EXPECT_EQ(host_sender.service(), 10u);
+  EXPECT_EQ(host_sender.service(), 11u);
   ContactProxy got;
   for (int poll = 0; poll < kMaxPolls && !rt_receiver.try_take_proxy(got); ++poll) rt_receiver.poll();
   test::expect_wire_equal(sent, got);
@@ -85,7 +86,7 @@ TEST(UdpCarrier, ProxyAndDeviceStateRoundTripOverLoopbackUdp) {
   for (int poll = 0; poll < kMaxPolls && !host_receiver.try_take_device_state(got_state); ++poll) host_receiver.poll();
   test::expect_wire_equal(state, got_state);
   EXPECT_EQ(talker.health().frames_received, 1u);
-  EXPECT_EQ(listener.health().frames_received, 10u);
+  EXPECT_EQ(listener.health().frames_received, 11u);
   test::expect_counts_add_up(rt_receiver.reassembler());
 }
 

@@ -82,7 +82,7 @@ TEST(WireCodec, PositionEpochHelpersKeepTheOtherBitsAndSkipZeroOnWrap) {
 }
 
 TEST(WireCodec, FullProxyTakesTenFramesAndRoundTrips) {
-  const ContactProxy sent = make_proxy(1234, kMaxContactPatches);
+  const ContactProxy sent = make_proxy(1234, kMaxContactPatches, 0);
   FrameBatch batch;
   ASSERT_EQ(encode(sent, 3, batch), EncodeStatus::kOk);
   ASSERT_EQ(batch.count, 10u);
@@ -96,11 +96,56 @@ TEST(WireCodec, FullProxyTakesTenFramesAndRoundTrips) {
   EXPECT_EQ(validate(reassembler.contact_proxy()), ProxyError::kNone);
 }
 
+TEST(WireCodec, FrictionTravelsOnlyForThePartsItsFlagsName) {
+  for (int mask = 0; mask < 8; ++mask) {
+    ContactProxy sent = make_proxy(500 + static_cast<std::uint64_t>(mask), 2, mask);
+    // Garbage in a part without its flag must not travel (and must not come back).
+    for (std::size_t part = 0; part < sent.friction.size(); ++part) {
+      if ((mask & (1 << part)) == 0) sent.friction[part].static_ratio = 99.0;
+    }
+    FrameBatch batch;
+    ASSERT_EQ(encode(sent, static_cast<std::uint8_t>(mask), batch), EncodeStatus::kOk);
+    const std::size_t parts = friction_parts_in(sent.flags);
+    EXPECT_EQ(parts, static_cast<std::size_t>(__builtin_popcount(static_cast<unsigned>(mask))));
+    EXPECT_EQ(batch.count, segments_for(proxy_message_bytes(2, parts))) << "mask " << mask;
+    Reassembler reassembler;
+    ASSERT_EQ(deliver(reassembler, batch), MessageType::kContactProxy) << "mask " << mask;
+    ContactProxy expected = sent;
+    for (std::size_t part = 0; part < sent.friction.size(); ++part) {
+      if ((mask & (1 << part)) == 0) expected.friction[part] = PartFriction{};
+    }
+    expect_wire_equal(expected, reassembler.contact_proxy());
+    EXPECT_EQ(validate(reassembler.contact_proxy()), ProxyError::kNone) << "mask " << mask;
+  }
+  // A clamp's full proxy with both jaws' friction: 654 B, 11 frames.
+  const ContactProxy clamp = make_proxy(77, kMaxContactPatches, 0b110);
+  FrameBatch batch;
+  ASSERT_EQ(encode(clamp, 1, batch), EncodeStatus::kOk);
+  EXPECT_EQ(batch.count, 11u);
+  Reassembler reassembler;
+  ASSERT_EQ(deliver(reassembler, batch), MessageType::kContactProxy);
+  expect_wire_equal(clamp, reassembler.contact_proxy());
+}
+
+TEST(WireCodec, FrictionRatiosRoundToTenThousandthsKeepingKineticAtMostStatic) {
+  EXPECT_EQ(friction_ratio_to_wire(0.0), 0u);
+  EXPECT_EQ(friction_ratio_to_wire(2.0), 20000u);
+  EXPECT_EQ(friction_ratio_from_wire(20000), 2.0);
+  EXPECT_EQ(friction_ratio_from_wire(friction_ratio_to_wire(0.4)), 0.4);
+  EXPECT_EQ(friction_ratio_to_wire(-1.0), 0u);
+  EXPECT_EQ(friction_ratio_to_wire(std::numeric_limits<double>::quiet_NaN()), 0xFFFFu) << "rejected by validation (> 2)";
+  EXPECT_EQ(friction_ratio_to_wire(1e9), 0xFFFFu);
+  for (double mu = 0.0; mu < 2.0; mu += 0.00137) {
+    EXPECT_LE(friction_ratio_to_wire(mu * 0.999), friction_ratio_to_wire(mu));
+    EXPECT_NEAR(friction_ratio_from_wire(friction_ratio_to_wire(mu)), mu, 0.5e-4 + 1e-12);
+  }
+}
+
 TEST(WireCodec, PartialProxySendsOnlyItsPatches) {
   // Frames per patch count: the table in docs/wire_protocol.md.
   constexpr std::array<std::size_t, 9> kFramesForPatches{1, 2, 3, 4, 5, 7, 8, 9, 10};
   for (std::uint16_t n = 0; n <= kMaxContactPatches; ++n) {
-    ContactProxy sent = make_proxy(100 + n, n);
+    ContactProxy sent = make_proxy(100 + n, n, 0);
     // Garbage beyond patch_count must not travel (and must not come back).
     for (std::size_t i = n; i < kMaxContactPatches; ++i) sent.patches[i].stiffness_k = 99.0;
     FrameBatch batch;
@@ -249,10 +294,27 @@ TEST(CanFdBusTime, PerMessageFiguresOfTheProtocolDocument) {
                                       {8, 1370.4, 1662.0}}};
   FrameBatch batch;
   for (const Row& row : kRows) {
-    ASSERT_EQ(encode(make_proxy(1, row.patches), 0, batch), EncodeStatus::kOk);
+    ASSERT_EQ(encode(make_proxy(1, row.patches, 0), 0, batch), EncodeStatus::kOk);
     EXPECT_NEAR(message_bus_time_us(batch, false), row.best_us, 0.05) << row.patches << " patches";
     EXPECT_NEAR(message_bus_time_us(batch, true), row.worst_us, 0.05) << row.patches << " patches";
   }
+  // With friction: the spatula's two patches and its one part; a clamp's full proxy, both jaws.
+  struct FrictionRow {
+    std::uint16_t patches;
+    int friction_mask;
+    std::size_t bytes;
+    double best_us;
+    double worst_us;
+  };
+  constexpr std::array<FrictionRow, 2> kFrictionRows{{{2, 0b001, 200, 494.4, 597.6}, {8, 0b110, 654, 1535.6, 1863.4}}};
+  for (const FrictionRow& row : kFrictionRows) {
+    ASSERT_EQ(encode(make_proxy(1, row.patches, row.friction_mask), 0, batch), EncodeStatus::kOk);
+    EXPECT_EQ(proxy_message_bytes(row.patches, friction_parts_in(make_proxy(1, row.patches, row.friction_mask).flags)), row.bytes);
+    EXPECT_NEAR(message_bus_time_us(batch, false), row.best_us, 0.05) << row.patches << " patches, friction " << row.friction_mask;
+    EXPECT_NEAR(message_bus_time_us(batch, true), row.worst_us, 0.05) << row.patches << " patches, friction " << row.friction_mask;
+  }
+  // The clamp's full proxy stays within CRC-32C's Hamming distance 6 (≤ 5243 bits, wire_codec.hpp).
+  EXPECT_LE(8 * proxy_message_bytes(kMaxContactPatches, 2), 5243u);
   ASSERT_EQ(encode(make_device_state(1), 0, batch), EncodeStatus::kOk);
   EXPECT_NEAR(message_bus_time_us(batch, false), 139.6, 0.05);
   EXPECT_NEAR(message_bus_time_us(batch, true), 169.4, 0.05);

@@ -28,8 +28,9 @@ class ContentRandom {
 };
 
 /// A valid proxy whose every field depends on `sequence`: two different proxies never agree,
-/// so a mix of two cannot pass for either.
-inline ContactProxy make_proxy(std::uint64_t sequence, std::uint16_t patch_count) {
+/// so a mix of two cannot pass for either. `friction_mask`: bit p = part p carries friction;
+/// < 0: the parts follow from `sequence` (every combination of the three occurs).
+inline ContactProxy make_proxy(std::uint64_t sequence, std::uint16_t patch_count, int friction_mask = -1) {
   ContentRandom random(sequence * 7919 + patch_count);
   ContactProxy proxy;
   proxy.sequence = sequence;
@@ -52,6 +53,17 @@ inline ContactProxy make_proxy(std::uint64_t sequence, std::uint16_t patch_count
     patch.reference_tool_orientation_world = {q[0], q[1], q[2], q[3]};
     patch.reference_time_ns = proxy.host_time_ns - static_cast<TimeNs>(random.next() % 1'000'000);
     patch.tool_part = static_cast<ToolPart>(random.next() % 3);
+  }
+  const auto mask = static_cast<std::uint32_t>(friction_mask < 0 ? static_cast<int>(sequence % 8) : friction_mask);
+  for (std::size_t part = 0; part < proxy.friction.size(); ++part) {
+    if ((mask & (1u << part)) == 0u) continue;
+    proxy.flags |= proxy_friction_bit(static_cast<ToolPart>(part));
+    PartFriction& friction = proxy.friction[part];
+    friction.host_force_world_n = {random.uniform(-2, 2), random.uniform(-2, 2), random.uniform(-2, 2)};
+    friction.reference_part_position_world_m = {random.uniform(-0.1, 0.1), random.uniform(-0.1, 0.1), random.uniform(-0.1, 0.1)};
+    friction.surface_velocity_world_m_per_s = {random.uniform(-0.5, 0.5), random.uniform(-0.5, 0.5), random.uniform(-0.5, 0.5)};
+    friction.static_ratio = random.uniform(0.0, 2.0);
+    friction.kinetic_ratio = random.uniform(0.0, friction.static_ratio);
   }
   return proxy;
 }
@@ -113,6 +125,24 @@ inline void expect_wire_equal(const ContactProxy& sent, const ContactProxy& rece
     EXPECT_EQ(b.reference_time_ns, a.reference_time_ns) << "patch " << i;
     EXPECT_EQ(b.tool_part, a.tool_part) << "patch " << i;
     EXPECT_EQ(b.reserved, 0u);
+  }
+  for (std::size_t part = 0; part < sent.friction.size(); ++part) {
+    const PartFriction& a = sent.friction[part];
+    const PartFriction& b = received.friction[part];
+    if ((sent.flags & proxy_friction_bit(static_cast<ToolPart>(part))) == 0u) {
+      const PartFriction empty{};
+      EXPECT_EQ(b.host_force_world_n, empty.host_force_world_n) << "part " << part;
+      EXPECT_EQ(b.static_ratio, empty.static_ratio) << "part " << part;
+      continue;
+    }
+    EXPECT_EQ(b.host_force_world_n, as_float32(a.host_force_world_n)) << "part " << part;
+    EXPECT_EQ(b.reference_part_position_world_m, as_float32(a.reference_part_position_world_m)) << "part " << part;
+    EXPECT_EQ(b.surface_velocity_world_m_per_s, as_float32(a.surface_velocity_world_m_per_s)) << "part " << part;
+    // μ travels in steps of 10⁻⁴ (wire_codec.hpp).
+    EXPECT_EQ(b.static_ratio, ::fissure::wire::friction_ratio_from_wire(::fissure::wire::friction_ratio_to_wire(a.static_ratio))) << "part " << part;
+    EXPECT_EQ(b.kinetic_ratio, ::fissure::wire::friction_ratio_from_wire(::fissure::wire::friction_ratio_to_wire(a.kinetic_ratio))) << "part " << part;
+    EXPECT_NEAR(b.static_ratio, a.static_ratio, 0.5e-4) << "part " << part;
+    EXPECT_LE(b.kinetic_ratio, b.static_ratio) << "part " << part;
   }
 }
 

@@ -68,4 +68,42 @@ struct GraspPullResult {
 [[nodiscard]] host::SceneDescription grasp_pull_scene();
 [[nodiscard]] GraspPullResult run_grasp_pull(const GraspPullOptions& options);
 
+/// The drag the hand feels (issue 23, "drag felt"): a closed-loop lockstep session — SimFalcon
+/// with the scene's scripted hand, rt_core, the host at host_rate_hz — of
+/// scenes/spatula-ball-drag.toml: the spatula pressed onto the ball's top with ~2 N and slid
+/// across it at 5 cm/s. Per rt tick the force commanded to the device is split along the contact
+/// normal rt_core evaluated (the direction of the proxy's elastic normal force on the tool): its
+/// tangential part against its normal part is the friction coefficient the hand feels.
+struct GraspDragOptions {
+  host::SceneDescription scene;       ///< default: grasp_drag_scene()
+  double host_rate_hz = 1000.0;
+  double rt_rate_hz = 1000.0;
+  double settle_s = 1.0;
+  /// The slide: ticks where the tool moves along the surface at ≥ this share of the hand's
+  /// scripted slide speed (5 cm/s), the normal force is ≥ 0.5 N and the host sees contact.
+  double sliding_speed_share = 0.8;
+};
+
+struct GraspDragResult {
+  double host_rate_hz = 0.0;
+  double friction_static_ratio = 0.0;
+  double friction_kinetic_ratio = 0.0;
+  int slide_ticks = 0;                   ///< ticks in the slide window (see GraspDragOptions)
+  double normal_median_n = 0.0;          ///< commanded force along the contact normal, median over the slide
+  double tangential_median_n = 0.0;      ///< commanded force across it, median over the slide
+  double ratio_median = 0.0;             ///< median over the slide of tangential / normal (per tick)
+  double ratio_p10 = 0.0, ratio_p90 = 0.0;
+  double host_friction_median_n = 0.0;   ///< the host's own friction force on the tool, median over the slide
+  double host_normal_median_n = 0.0;     ///< the host's normal (Hunt-Crossley) force on the tool, median over the slide
+  double sliding_tick_share = 0.0;       ///< share of the slide's ticks on which rt_core's cone slid
+  double slide_speed_median_m_per_s = 0.0;
+  double max_force_step_n = 0.0;         ///< max |ΔF| per tick of the commanded force over the whole session
+  double energy_max_j = 0.0;             ///< passivity observer's largest value over the session
+  int crossed_nodes_max = 0;
+  bool finite = true;
+};
+
+[[nodiscard]] host::SceneDescription grasp_drag_scene();
+[[nodiscard]] GraspDragResult run_grasp_drag(const GraspDragOptions& options);
+
 }  // namespace fissure::eval

@@ -52,6 +52,11 @@ struct ProxyBuilderModel {
   /// Which rt tool part a host jaw's contacts act on: kTool for a spatula, kJawA/kJawB for the
   /// clamp's jaws (rt's convention: A is the jaw on the −e_c side, see shared/device_mapping.hpp).
   std::array<ToolPart, kMaxProxyJaws> part_of_jaw{ToolPart::kTool, ToolPart::kTool};
+  /// The tool–tissue Coulomb coefficients ([tool] friction_*_ratio), carried with each pushed
+  /// part's friction (PartFriction) for rt_core's friction cone (rt_core/friction_cone.hpp); 0
+  /// sends none.
+  double friction_static_ratio = 0.0;
+  double friction_kinetic_ratio = 0.0;
 };
 
 /// Position and velocity of each rt tool part (indexed by ToolPart) at the host's step, world
@@ -60,6 +65,13 @@ struct ProxyPartMotion {
   std::array<Eigen::Vector3d, 3> p_world_m{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   std::array<Eigen::Vector3d, 3> v_world_m_per_s{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
                                                  Eigen::Vector3d::Zero()};
+  /// The host's friction force on each part at this step (in-solver friction; zero without).
+  std::array<Eigen::Vector3d, 3> friction_force_world_n{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                                                        Eigen::Vector3d::Zero()};
+  /// Velocity of the tissue surface under each part (contact-force-weighted mean of the contacted
+  /// triangles' node velocities): rt_core's stick anchor moves with it between host steps.
+  std::array<Eigen::Vector3d, 3> surface_velocity_world_m_per_s{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                                                                Eigen::Vector3d::Zero()};
 };
 
 /// What one build did (diagnostics; the session logs it).

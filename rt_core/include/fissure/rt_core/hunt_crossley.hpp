@@ -21,6 +21,7 @@
 // (passivity.hpp): the environment may return what it stores.
 #include <limits>
 
+#include "fissure/rt_core/friction_cone.hpp"
 #include "fissure/shared/device_mapping.hpp"
 #include "fissure/shared/messages.hpp"
 #include "fissure/shared/session_config.hpp"
@@ -46,8 +47,10 @@ struct DampingCap {
 };
 
 /// Adds every patch's force to `forces` (cleared first), world frame, per tool part, with each
-/// patch's damping capped by `cap` (Colgate–Schenkel, above).
+/// patch's damping capped by `cap` (Colgate–Schenkel, above). With `load`, also the elastic
+/// normal force per part (the friction cone's input).
 ContactEvaluation evaluate_proxy(const ContactProxy& proxy, const DeviceMapping& mapping, const ToolState& tool,
-                                 PartForces& forces, const DampingCap& cap = DampingCap{}) noexcept;
+                                 PartForces& forces, const DampingCap& cap = DampingCap{},
+                                 PartNormalLoad* load = nullptr) noexcept;
 
 }  // namespace fissure::rt

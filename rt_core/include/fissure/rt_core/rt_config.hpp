@@ -7,6 +7,7 @@
 #include "fissure/falcon_hw/falcon_geometry.hpp"
 #include "fissure/falcon_hw/kinematics.hpp"
 #include "fissure/falcon_hw/motor_command.hpp"
+#include "fissure/rt_core/friction_cone.hpp"
 #include "fissure/rt_core/hunt_crossley.hpp"
 #include "fissure/rt_core/joint_angles.hpp"
 #include "fissure/rt_core/passivity.hpp"
@@ -42,6 +43,7 @@ struct RtConfig {
   KinematicsConfig kinematics{};
   VelocityFilterConfig velocity{};
   ProxyConfig proxy{};
+  FrictionConfig friction{};
   PassivityConfig passivity{};
   SafetyConfig safety{};
   FaultConfig faults{};
@@ -57,6 +59,8 @@ struct RtModel {
   /// Device-port joules per world joule of stored contact energy: F_device·Δp_device =
   /// (force_scale / scale)·F_world·Δp_world (device_mapping.hpp).
   double device_energy_per_world_energy = 1.0;
+  /// The friction stage in world units (friction_cone.hpp): K_t = K_device / (force_scale·scale).
+  FrictionModel friction{};
 };
 
 /// First problem in `config` as a static string naming the field ("rate_hz must be in

@@ -8,6 +8,7 @@
 #include "fissure/falcon_hw/haptic_device.hpp"
 #include "fissure/shared/device_mapping.hpp"
 #include "fissure/rt_core/force_position.hpp"
+#include "fissure/rt_core/friction_cone.hpp"
 #include "fissure/rt_core/forward_kinematics_stage.hpp"
 #include "fissure/rt_core/joint_angles.hpp"
 #include "fissure/rt_core/passivity.hpp"
@@ -56,6 +57,10 @@ struct RtData {
   ToolState tool{};
   ProxyState proxy{};
   PartForces part_forces{};
+  PartNormalLoad normal_load{};             ///< the friction cone's input from the proxy in use
+  FrictionState friction{};                 ///< stick anchors per tool part (friction_cone.hpp)
+  Eigen::Vector3d friction_force_device_n = Eigen::Vector3d::Zero();  ///< friction share of new_force
+  int parts_sliding = 0;
   BlendState blend{};
   FadeState fade{};
   double max_penetration_m = -1.0;

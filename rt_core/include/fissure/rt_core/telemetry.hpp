@@ -21,6 +21,7 @@ struct TelemetrySample {
   Vec3 tool_position_world_m{};           ///< after the device → world mapping
   Vec3 contact_force_device_n{};          ///< proxy force after blend and fade, before passivity/safety
   Vec3 force_device_n{};                  ///< force commanded (after safety) — goes out next exchange
+  Vec3 friction_force_device_n{};         ///< friction share of the proxy force at this position, faded (no blend)
   std::array<std::int16_t, 3> motor_counts{};
   std::uint16_t patches_in_contact = 0;
   double jaw_closing_m = 0.0;
@@ -36,6 +37,7 @@ struct TelemetrySample {
   std::uint32_t buttons = 0;
   std::uint8_t io_status = 0;             ///< falcon::IoStatus of this tick's exchange
   std::int8_t fk_iterations = 0;
+  std::uint8_t parts_sliding = 0;         ///< tool parts whose friction cone slides this tick
 };
 static_assert(std::is_trivially_copyable_v<TelemetrySample>);
 

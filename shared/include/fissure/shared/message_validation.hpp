@@ -21,6 +21,14 @@ struct ProxyLimits {
   /// n: 1 (flat punch) to 2; Hertz is 1.5 (BRIEF §4). 3 tolerates exotic fits.
   static constexpr double kMinExponent = 0.5;
   static constexpr double kMaxExponent = 3.0;
+  /// μ_s, μ_k: measured tool–tissue coefficients span 0.11–0.83 (Heijnsdijk 2004, docs/scenes.md);
+  /// 2 is the scene loader's own bound ([tool] friction_static_ratio).
+  static constexpr double kMaxFrictionRatio = 2.0;
+  /// |host friction force| [N]: 100× the Falcon's 8 N rating, in world units at force_scale 0.01;
+  /// only rejects garbage.
+  static constexpr double kMaxFrictionForce_n = 800.0;
+  /// Tissue surface speed per axis [m/s]: the tunnelling benchmark's fastest tool is 50 m/s.
+  static constexpr double kMaxSurfaceSpeed_m_per_s = 100.0;
 };
 
 enum class ProxyError : std::uint8_t {
@@ -34,12 +42,14 @@ enum class ProxyError : std::uint8_t {
   kDampingOutOfRange,
   kExponentOutOfRange,
   kBadToolPart,
+  kFrictionOutOfRange,  ///< a present part's friction: μ_s or μ_k outside [0, 2], μ_k > μ_s, force, position or surface speed out of range
 };
 
 /// Human-readable name of an error (static string, no allocation).
 const char* to_string(ProxyError error) noexcept;
 
-/// First problem found in `proxy`, or kNone. `bad_patch` receives the offending index.
+/// First problem found in `proxy`, or kNone. `bad_patch` receives the offending patch index
+/// (for kFrictionOutOfRange and a non-finite friction: −1).
 ProxyError validate(const ContactProxy& proxy, int* bad_patch = nullptr) noexcept;
 
 /// True when every number in the sample is finite.

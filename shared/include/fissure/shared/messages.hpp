@@ -25,7 +25,9 @@ namespace fissure {
 /// 2: DeviceState::status_flags bits 24..31 carry the position epoch (below).
 /// 3: the Hello carries the session fingerprint and scene name, and a closing flag
 ///    (wire_codec.hpp, wire_handshake.hpp).
-inline constexpr std::uint16_t kProtocolVersion = 3;
+/// 4: the ContactProxy carries friction per tool part (PartFriction: μ and the host's friction
+///    force at its reference pose) for rt_core's friction cone.
+inline constexpr std::uint16_t kProtocolVersion = 4;
 
 /// One patch per tool face or jaw is enough for the paper's tools (spatula: 2 faces,
 /// clamp: 2 jaws × 2 faces); 8 leaves room for a convex tool's rim.
@@ -106,6 +108,7 @@ enum class ToolPart : std::uint32_t { kTool = 0, kJawA = 1, kJawB = 2 };
 /// rt_core evaluates it against the *current* tool position p_tool_world:
 ///   x = (plane_point_world_m − p_tool_world) · normal_world   (penetration, m)
 ///   F = max(0, k·xⁿ + λ·xⁿ·ẋ) · normal_world  for x > 0, else 0
+/// Friction is per tool part, not per patch (PartFriction below).
 struct ContactPatch {
   Vec3 plane_point_world_m{};        ///< a point on the zero-penetration plane, world frame [m]
   Vec3 normal_world{};               ///< unit normal, world frame: direction of the force on the tool
@@ -121,10 +124,35 @@ struct ContactPatch {
 static_assert(std::is_trivially_copyable_v<ContactPatch>);
 static_assert(sizeof(ContactPatch) == 144);
 
+/// Coulomb friction on one tool part (rt_core/friction_cone.hpp). rt_core renders, at the current
+/// position, the host's friction force continued by a stick spring to the tissue surface, which
+/// moves on at the surface's velocity, inside the cone μ × the patches' normal force — so a part
+/// sliding over tissue feels μ_k·F_n from the first tick, and a part holding tissue that moves with
+/// it (a lifted vessel) feels what the tissue pulls, not a phantom slide.
+struct PartFriction {
+  Vec3 host_force_world_n{};               ///< the host's friction force on the part at its reference pose [N]
+  Vec3 reference_part_position_world_m{};  ///< the part's position then (tool origin or jaw, rt's convention) [m]
+  Vec3 surface_velocity_world_m_per_s{};   ///< velocity of the tissue under the part then (force-weighted) [m/s]
+  double static_ratio = 0.0;               ///< Coulomb μ_s of the tool–tissue pair [-], 0 … 2
+  double kinetic_ratio = 0.0;              ///< Coulomb μ_k [-], 0 … μ_s
+};
+static_assert(std::is_trivially_copyable_v<PartFriction>);
+static_assert(sizeof(PartFriction) == 88);
+
 enum ContactProxyBits : std::uint32_t {
   kProxyValid = 1u << 0,             ///< host asserts the content is usable
   kProxyHostInContact = 1u << 1,     ///< host saw contact at the reference pose
+  /// Bits 2..4: ContactProxy::friction[part] is meaningful (part = bit − 2); a part without its
+  /// bit has no friction. Only these parts' friction travels on the wire.
+  kProxyFrictionTool = 1u << 2,
+  kProxyFrictionJawA = 1u << 3,
+  kProxyFrictionJawB = 1u << 4,
 };
+inline constexpr unsigned kProxyFrictionShift = 2;
+/// The flag bit that says part `part`'s friction is present.
+constexpr std::uint32_t proxy_friction_bit(ToolPart part) noexcept {
+  return 1u << (kProxyFrictionShift + static_cast<std::uint32_t>(part));
+}
 
 /// The contact proxy host_sim publishes after each step (host_sim → rt_core).
 struct ContactProxy {
@@ -134,9 +162,10 @@ struct ContactProxy {
   std::uint16_t patch_count = 0;     ///< patches[0, patch_count) are meaningful
   std::uint32_t flags = 0;           ///< ContactProxyBits
   std::array<ContactPatch, kMaxContactPatches> patches{};
+  std::array<PartFriction, 3> friction{};  ///< indexed by ToolPart; meaningful where flags has proxy_friction_bit
 };
 static_assert(std::is_trivially_copyable_v<ContactProxy>);
 static_assert(offsetof(ContactProxy, patches) == 24);
-static_assert(sizeof(ContactProxy) == 24 + kMaxContactPatches * sizeof(ContactPatch));
+static_assert(sizeof(ContactProxy) == 24 + kMaxContactPatches * sizeof(ContactPatch) + 3 * sizeof(PartFriction));
 
 }  // namespace fissure

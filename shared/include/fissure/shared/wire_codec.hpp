@@ -76,13 +76,35 @@ inline constexpr std::size_t kHelloBodyBytes = kHelloPrefixBodyBytes + 8 + kHell
 inline constexpr std::size_t kDeviceStateBodyBytes = 52;
 inline constexpr std::size_t kProxyFixedBodyBytes = 18;
 inline constexpr std::size_t kPatchBodyBytes = 69;
+/// Per tool part whose friction bit is set (messages.hpp, PartFriction): 9 × f32 and μ_s, μ_k
+/// as u16 in steps of 1/kFrictionRatioStepsPerUnit — 40 B, so a clamp's full proxy (8 patches, both jaws'
+/// friction: 654 B = 5232 bits) stays within CRC-32C's Hamming distance 6 (≤ 5243 bits).
+inline constexpr std::size_t kPartFrictionBodyBytes = 40;
+/// μ on the wire: round(μ · 10⁴) as u16 — 10⁻⁴ is far finer than any measured coefficient
+/// (0.11–0.83 ± a few hundredths, docs/scenes.md), and 2 (the largest valid μ) is 20000.
+inline constexpr double kFrictionRatioStepsPerUnit = 1.0e4;
+/// Rounding is monotonic, so μ_k ≤ μ_s survives the trip; an out-of-range μ is clamped to
+/// [0, 6.5535] and a NaN is sent as 0xFFFF (6.5535), which validation rejects (> 2).
+constexpr std::uint16_t friction_ratio_to_wire(double ratio) noexcept {
+  if (!(ratio >= 0.0)) return ratio < 0.0 ? std::uint16_t{0} : std::uint16_t{0xFFFF};
+  const double steps = ratio * kFrictionRatioStepsPerUnit + 0.5;
+  return steps >= 65535.0 ? std::uint16_t{0xFFFF} : static_cast<std::uint16_t>(steps);
+}
+constexpr double friction_ratio_from_wire(std::uint16_t steps) noexcept { return steps / kFrictionRatioStepsPerUnit; }
 
-constexpr std::size_t proxy_message_bytes(std::size_t patch_count) noexcept {
-  return kProxyFixedBodyBytes + kPatchBodyBytes * patch_count + kCrcBytes;
+/// How many parts' friction a proxy with these flags carries.
+constexpr std::size_t friction_parts_in(std::uint32_t flags) noexcept {
+  std::size_t count = 0;
+  for (unsigned part = 0; part < 3; ++part) count += (flags >> (kProxyFrictionShift + part)) & 1u;
+  return count;
+}
+
+constexpr std::size_t proxy_message_bytes(std::size_t patch_count, std::size_t friction_parts = 0) noexcept {
+  return kProxyFixedBodyBytes + kPatchBodyBytes * patch_count + kPartFrictionBodyBytes * friction_parts + kCrcBytes;
 }
 inline constexpr std::size_t kHelloMessageBytes = kHelloBodyBytes + kCrcBytes;
 inline constexpr std::size_t kDeviceStateMessageBytes = kDeviceStateBodyBytes + kCrcBytes;
-inline constexpr std::size_t kMaxMessageBytes = proxy_message_bytes(kMaxContactPatches);
+inline constexpr std::size_t kMaxMessageBytes = proxy_message_bytes(kMaxContactPatches, 3);
 
 constexpr std::size_t segments_for(std::size_t message_bytes) noexcept {
   return (message_bytes + kSegmentBytes - 1) / kSegmentBytes;
