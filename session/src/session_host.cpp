@@ -4,6 +4,7 @@
 
 #include <array>
 #include <chrono>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -31,10 +32,19 @@ host::ProxyBuilderModel session_proxy_model(const host::SceneDescription& scene,
   return *model;
 }
 
+// Time constant of the low-pass on the tissue's velocity under a part [s]. The contacted nodes'
+// velocities jitter by centimetres per second from step to step (clamp-vessel-lift: ±3 cm/s about
+// a 2 cm/s lift); over 20 ms (20 steps at 1 kHz) that averages to a few mm/s, and a grip or a lift
+// changes speed over hundreds of ms.
+constexpr double kSurfaceVelocityFilter_s = 0.02;
+
 // rt_core's friction cone needs, per tool part, the host's friction force on it and the velocity
 // of the tissue under it (messages.hpp, PartFriction): the contacted triangles' node velocities,
-// weighted by each triangle's contact force.
+// weighted by each triangle's contact force and low-passed (kSurfaceVelocityFilter_s). (The share
+// of held nodes that stick is no estimate: a spatula sliding over tissue advances by contact
+// turnover while most held nodes stick for the step — spatula-ball-drag.)
 void add_friction_inputs(const host::HostStepResult& result, const host::ProxyBuilderModel& model, const btSoftBody& soft,
+                         double dt_s, double sub_step_s, std::array<Eigen::Vector3d, 3>& filtered_velocity,
                          host::ProxyPartMotion& parts) {
   std::array<double, 3> weight_n{0.0, 0.0, 0.0};
   std::array<Eigen::Vector3d, 3> weighted{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
@@ -50,13 +60,24 @@ void add_friction_inputs(const host::HostStepResult& result, const host::ProxyBu
     }
     const btSoftBody::Face& face = soft.m_faces[record.soft_face];
     Eigen::Vector3d v = Eigen::Vector3d::Zero();
-    for (const btSoftBody::Node* node : face.m_n) v += Eigen::Vector3d(node->m_v.x(), node->m_v.y(), node->m_v.z()) / 3.0;
+    // Over the last sub-step, from positions (m_q: where it started): m_v misses the moves the
+    // in-solver contact makes after Bullet's velocity update.
+    for (const btSoftBody::Node* node : face.m_n) {
+      const btVector3 moved = node->m_x - node->m_q;
+      v += Eigen::Vector3d(moved.x(), moved.y(), moved.z()) / (3.0 * sub_step_s);
+    }
     const auto part = static_cast<std::size_t>(model.part_of_jaw[static_cast<std::size_t>(record.jaw)]);
     weighted[part] += record.force_n * v;
     weight_n[part] += record.force_n;
   }
+  const double share = std::min(1.0, dt_s / kSurfaceVelocityFilter_s);
   for (std::size_t part = 0; part < weighted.size(); ++part) {
-    if (weight_n[part] > 0.0) parts.surface_velocity_world_m_per_s[part] = weighted[part] / weight_n[part];
+    if (weight_n[part] > 0.0 && weighted[part].allFinite()) {
+      filtered_velocity[part] += share * (weighted[part] / weight_n[part] - filtered_velocity[part]);
+    } else {
+      filtered_velocity[part].setZero();
+    }
+    parts.surface_velocity_world_m_per_s[part] = filtered_velocity[part];
   }
 }
 
@@ -129,7 +150,10 @@ const HostStatus& SessionHost::step(DeviceStateExchange& state_in, ProxyExchange
     parts.v_world_m_per_s[static_cast<std::size_t>(part)] = motion.v_world_m_per_s;
   }
   const host::ProxyBuilderModel& proxy_model = builder_.model();
-  if (proxy_model.friction_static_ratio > 0.0) add_friction_inputs(result, proxy_model, sim_.world().soft(), parts);
+  if (proxy_model.friction_static_ratio > 0.0) {
+    add_friction_inputs(result, proxy_model, sim_.world().soft(), scene_.simulation.time_step_s,
+                        scene_.simulation.time_step_s / scene_.simulation.substeps_count, surface_velocity_world_m_per_s_, parts);
+  }
   const auto host_time_ns = static_cast<TimeNs>(std::llround(result.time_s * 1e9));
   builder_.build(result.contacts, pose_, parts, host_time_ns, proxy_);
   proxy_out.publish(proxy_);

@@ -296,6 +296,10 @@ void expect_grasp_session(const SessionOutcome& outcome, const fs::path& out) {
   EXPECT_GT(column_max(trace, "host_jaw_a_friction_n"), 0.05) << "the grip holds by friction";
   EXPECT_GT(column_max(trace, "host_jaw_b_friction_n"), 0.05);
   EXPECT_LT(column_min(trace, "host_jaw_gap_m"), 0.03) << "the hand closed the jaws on the 30 mm vessel";
+  // rt_core renders the friction at the hand (friction_cone.hpp), within the static cone of the
+  // jaws' force: never more than the commanded force itself.
+  EXPECT_GT(column_max(trace, "friction_n"), 0.1) << "the hand feels the drag";
+  EXPECT_LE(column_max(trace, "friction_n"), column_max(trace, "contact_force_n") + 0.05);
 }
 
 TEST_F(SessionRunnerTest, TheLiftSceneGraspsLiftsAndReleasesTheVesselEndToEnd) {

@@ -51,7 +51,7 @@ inline constexpr double kDefaultFrictionStickStiffness_n_per_m = 1000.0;
 /// Time constant of the anchor's walk towards the host's friction state [s]: long beside a 1 kHz
 /// host step, so the host's node-by-node stick–slip averages out (its friction swings ±0.2 N
 /// from step to step), short beside a grip or a lift (hundreds of ms).
-inline constexpr double kDefaultFrictionHostFollow_s = 0.05;
+inline constexpr double kDefaultFrictionHostFollow_s = 0.02;
 /// Largest force change per tick from the walk [N]: the blend's bound for a proxy swap
 /// (ProxyConfig::blend_max_step_n, issue 6), for the same reason: the hand must not feel it as a
 /// click.

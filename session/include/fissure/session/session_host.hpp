@@ -72,6 +72,10 @@ class SessionHost {
   double settled_volume_m3_ = 0.0;    ///< soft body's enclosed volume at construction / after settle()
   ContactProxy proxy_{};
   HostStatus status_{};
+  /// Per rt tool part: the low-passed velocity of the tissue under it (session_host.cpp,
+  /// add_friction_inputs), zero while the part holds no tissue.
+  std::array<Eigen::Vector3d, 3> surface_velocity_world_m_per_s_{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                                                                 Eigen::Vector3d::Zero()};
 };
 
 }  // namespace fissure::session
