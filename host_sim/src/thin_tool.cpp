@@ -278,6 +278,12 @@ ToolNodes ToolNodes::from_convex_mesh(const ConvexMeshToolShape& shape) {
 }
 
 void ToolNodes::finish_pairing() {
+  feature_edge_midpoints_tool_m_.clear();
+  feature_edge_half_lengths_m_.clear();
+  for (const auto& edge : feature_edges_tool_m_) {
+    feature_edge_midpoints_tool_m_.push_back(0.5 * (edge[0] + edge[1]));
+    feature_edge_half_lengths_m_.push_back(0.5 * (edge[1] - edge[0]).norm());
+  }
   const int count = node_count();
   paired_by_begin_.assign(static_cast<std::size_t>(count + 1), 0);
   for (const int pair : pair_of_)

@@ -140,7 +140,16 @@ TriangleToolExtent triangle_tool_extent(const ToolNodes& tool, const std::array<
     extent.highest_m = std::max(extent.highest_m, h);
     extent.meets = true;
   };
-  for (const auto& edge : tool.feature_edges_tool_m()) {
+  const auto& edges = tool.feature_edges_tool_m();
+  const auto& midpoints = tool.feature_edge_midpoints_tool_m();
+  const auto& half_lengths = tool.feature_edge_half_lengths_m();
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    // Every point of the edge lies within half its length of its midpoint: a midpoint farther than
+    // radius + that from the normal line leaves the whole edge outside the cylinder (the slack
+    // keeps rounding from dropping an edge the exact test below would keep).
+    const double reach = radius_m + half_lengths[e] + kInsideTolerance_m;
+    if (across(midpoints[e]).squaredNorm() > reach * reach) continue;
+    const auto& edge = edges[e];
     const Eigen::Vector3d a = across(edge[0]);
     const Eigen::Vector3d ab = across(edge[1]) - a;
     const double ab2 = ab.squaredNorm();

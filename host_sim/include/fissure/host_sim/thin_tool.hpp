@@ -111,6 +111,9 @@ class ToolNodes {
   // triangle edges between two different planes), as end points in the tool frame: the rim a soft
   // triangle can be draped over, and must not be cut by.
   [[nodiscard]] const std::vector<std::array<Eigen::Vector3d, 2>>& feature_edges_tool_m() const { return feature_edges_tool_m_; }
+  // Per feature edge: its midpoint and half its length (the ball round it), for a cheap first test.
+  [[nodiscard]] const std::vector<Eigen::Vector3d>& feature_edge_midpoints_tool_m() const { return feature_edge_midpoints_tool_m_; }
+  [[nodiscard]] const std::vector<double>& feature_edge_half_lengths_m() const { return feature_edge_half_lengths_m_; }
 
   // Signed distance to the tool's convex volume from a point in the tool frame: max over planes
   // of (n·p − offset). Exact inside (−depth to the nearest face), a lower bound outside.
@@ -134,6 +137,8 @@ class ToolNodes {
   std::vector<ToolPlane> planes_;
   std::vector<Eigen::Vector3d> hull_vertices_tool_m_;
   std::vector<std::array<Eigen::Vector3d, 2>> feature_edges_tool_m_;
+  std::vector<Eigen::Vector3d> feature_edge_midpoints_tool_m_;
+  std::vector<double> feature_edge_half_lengths_m_;
   // Footprint along the thin axis as 2-D half-planes (a·(u,v) ≤ b) of the projected hull.
   std::vector<Eigen::Vector3d> footprint_halfplanes_;
   PairingReport report_;
