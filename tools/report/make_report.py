@@ -824,6 +824,20 @@ def section_grasp(report, data, problems, targets):
     report.add(f"Least-squares fit: pull-out = {fmt(pull['intercept_n'])} N + {fmt(pull['slope'])} × grip "
                f"(2μ = {fmt(2 * pull['friction_ratio'])}).")
     report.add("")
+    drag = grasp.get("drag")
+    if drag:
+        report.add("Drag felt (`scenes/spatula-ball-drag.toml`, a lockstep session: SimFalcon's hand presses the spatula onto "
+                   "the ball with ~2 N and slides it 20 mm at 5 cm/s; per rt tick the force commanded to the device is split "
+                   "along the contact normal rt_core evaluated; medians over the ticks the tool slides):")
+        report.add("")
+        report.add(table(["host Hz", "slide ticks", "speed cm/s", "normal N", "tangential N", "tangential / normal (p10–p90)",
+                          "μ_k", "host's own friction / normal", "cone sliding %", "max ΔF / tick N"],
+                         [[fmt(r["host_rate_hz"]), r["slide_ticks"], fmt(100 * r["slide_speed_median_m_per_s"]), fmt(r["normal_median_n"]),
+                           fmt(r["tangential_median_n"]), f"{r['ratio_median']:.4f} ({r['ratio_p10']:.3f}–{r['ratio_p90']:.3f})",
+                           fmt(r["friction_kinetic_ratio"]),
+                           f"{r['host_friction_median_n'] / r['host_normal_median_n']:.3f}" if r["host_normal_median_n"] > 0 else "-",
+                           fmt(100 * r["sliding_tick_share"]), fmt(r["max_force_step_n"])] for r in drag]))
+        report.add("")
     report.add(targets_table([t for t in targets if t.section == "grasp"]))
 
 
