@@ -97,6 +97,7 @@ bool build_model(const RtConfig& config, RtModel& model, const char** error) noe
                                   ? config.friction.max_step_n / config.mapping.force_scale /
                                         model.friction.stick_stiffness_world_n_per_m
                                   : 0.0;
+  model.friction.max_step_world_n = config.mapping.force_scale > 0.0 ? config.friction.max_step_n / config.mapping.force_scale : 0.0;
   model.friction.period_s = model.period_s;
   return true;
 }

@@ -52,9 +52,16 @@ ToolState tool_at(double x, double y = 0.0, double z = 0.0, const Eigen::Vector3
 }
 
 // The cone alone (no walk towards the host), and the stage as rt_core runs it (τ = 50 ms).
-constexpr FrictionModel kConeOnly{kStickStiffness_n_per_m, 0.0, 0.0, kPeriod_s};
-constexpr FrictionModel kWithWalk{kStickStiffness_n_per_m, kPeriod_s / kDefaultFrictionHostFollow_s,
-                                  kDefaultFrictionMaxStep_n / kStickStiffness_n_per_m, kPeriod_s};
+constexpr FrictionModel kConeOnly{.stick_stiffness_world_n_per_m = kStickStiffness_n_per_m,
+                                  .walk_share = 0.0,
+                                  .max_walk_m = 0.0,
+                                  .max_step_world_n = std::numeric_limits<double>::infinity(),
+                                  .period_s = kPeriod_s};
+constexpr FrictionModel kWithWalk{.stick_stiffness_world_n_per_m = kStickStiffness_n_per_m,
+                                  .walk_share = kPeriod_s / kDefaultFrictionHostFollow_s,
+                                  .max_walk_m = kDefaultFrictionMaxStep_n / kStickStiffness_n_per_m,
+                                  .max_step_world_n = kDefaultFrictionMaxStep_n,
+                                  .period_s = kPeriod_s};
 
 FrictionEvaluation tick(FrictionState& state, const ContactProxy& proxy, const ToolState& tool,
                         const PartNormalLoad& load = floor_load(), const DeviceMapping& mapping = DeviceMapping{},
@@ -117,6 +124,24 @@ TEST(FrictionCone, BreaksAwayAtStaticTimesNormalAndSlidesAtKineticTimesNormal) {
   // The last stuck step is within one step's spring of the static bound, never above it.
   EXPECT_LE(largest_stick_n, kMuStatic * kNormal_n + 1e-12);
   EXPECT_GT(largest_stick_n, kMuStatic * kNormal_n - kStickStiffness_n_per_m * 1e-5 - 1e-12);
+}
+
+TEST(FrictionCone, TheDropFromStaticToKineticAtBreakAwayIsSpreadAtTheStepBound) {
+  FrictionState state;
+  const ContactProxy proxy = friction_proxy(1, Eigen::Vector3d::Zero());
+  double previous = 0.0;
+  double largest_step = 0.0;
+  bool slid = false;
+  for (int i = 0; i <= 300; ++i) {
+    const double f = tick(state, proxy, tool_at(1e-5 * i), floor_load(), DeviceMapping{}, kWithWalk).force_world_n.force_world_n[0].norm();
+    largest_step = std::max(largest_step, std::abs(f - previous));
+    previous = f;
+    slid = slid || state.sliding[0];
+  }
+  ASSERT_TRUE(slid);
+  // The stick spring's own step (K_t × 10 µm) and the drop's 0.05 N: never the whole 0.2 N.
+  EXPECT_LE(largest_step, kDefaultFrictionMaxStep_n + 1e-12);
+  EXPECT_NEAR(previous, kMuKinetic * kNormal_n, 1e-12) << "it ends on the kinetic cone";
 }
 
 TEST(FrictionCone, AHandThatStopsAfterASlideSticksAndBacksOffAlongTheSpring) {
@@ -252,7 +277,8 @@ TEST(FrictionCone, NoFlagNoMuOrZeroStiffnessRenderNothing) {
   for (int i = 0; i < 10; ++i) {
     EXPECT_EQ(tick(state, unflagged, tool_at(1e-3 * i)).force_world_n.force_world_n[0], Eigen::Vector3d::Zero());
     EXPECT_EQ(tick(state, frictionless, tool_at(1e-3 * i)).force_world_n.force_world_n[0], Eigen::Vector3d::Zero());
-    const FrictionModel no_stiffness{0.0, 0.0, 0.0, kPeriod_s};
+    FrictionModel no_stiffness = kConeOnly;
+    no_stiffness.stick_stiffness_world_n_per_m = 0.0;
     const FrictionEvaluation off = evaluate_friction(no_stiffness, state, normal, floor_load(), DeviceMapping{}, tool_at(1e-3 * i));
     EXPECT_EQ(off.force_world_n.force_world_n[0], Eigen::Vector3d::Zero());
   }

@@ -13,7 +13,8 @@
 //      (Σ k·xⁿ·n over its patches, hunt_crossley.hpp):
 //        d = (p − anchor) without its component along n̂,  F_t = −K_t·d
 //        |F_t| > μ·F_n → slide: the anchor follows to |d| = μ_k·F_n/K_t, F_t = −μ_k·F_n·d̂
-//      with μ = μ_s to break away from sticking and μ_k while sliding.
+//      with μ = μ_s to break away from sticking and μ_k while sliding; the drop from μ_s·F_n to
+//      μ_k·F_n at break-away is spread at max_step_n per tick (a few ms).
 //
 // Why the split: only rt_core knows where the hand is now, and only the host knows what the
 // tissue does. The cone at the device rate makes the drag exact and immediate: a part sliding
@@ -62,7 +63,7 @@ struct FrictionConfig {
   double stick_stiffness_device_n_per_m = kDefaultFrictionStickStiffness_n_per_m;
   /// τ of the walk towards the host's state [s], > 0.
   double host_follow_s = kDefaultFrictionHostFollow_s;
-  /// Largest force change per tick from the walk, at the device [N], > 0.
+  /// Largest force change per tick from the walk and from the break-away drop, at the device [N], > 0.
   double max_step_n = kDefaultFrictionMaxStep_n;
 };
 
@@ -71,6 +72,7 @@ struct FrictionModel {
   double stick_stiffness_world_n_per_m = 0.0;  ///< K_t
   double walk_share = 0.0;                     ///< T/τ, ≤ 1
   double max_walk_m = 0.0;                     ///< max_step_n (world) / K_t
+  double max_step_world_n = 0.0;               ///< max_step_n in world newtons: also the static → kinetic drop per tick
   double period_s = 0.0;                       ///< T
 };
 
@@ -86,6 +88,7 @@ struct FrictionState {
                                                 Eigen::Vector3d::Zero()};
   std::array<bool, 3> anchored{false, false, false};
   std::array<bool, 3> sliding{false, false, false};
+  std::array<double, 3> last_force_n{0.0, 0.0, 0.0};  ///< |F_t| rendered last tick (world)
 };
 
 /// What one evaluation rendered (telemetry, the passivity reference).
