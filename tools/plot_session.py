@@ -1,6 +1,6 @@
 #!/usr/bin/python3
-"""Plot a `fissure run` trace: force, penetration, proxy age and, for a clamp, the jaw gap and the per-jaw
-normal and friction force against time.
+"""Plot a `fissure run` trace: force (and rt_core's rendered friction, where there is any), penetration, proxy
+age and, for a clamp, the jaw gap and the per-jaw normal and friction force against time.
 
 usage: plot_session.py TRACE.csv OUT.png [--title TEXT]
 Uses only the standard library's csv module and matplotlib (Debian's python3-matplotlib).
@@ -18,7 +18,7 @@ REQUIRED_COLUMNS = ["time_s", "force_n", "contact_force_n", "host_force_n", "pen
                     "host_penetration_m", "proxy_age_ms"]
 # Traces written before the jaw gap was recorded have no such column: they plot without it.
 OPTIONAL_COLUMNS = ["host_jaw_gap_m", "host_jaw_a_normal_n", "host_jaw_a_friction_n", "host_jaw_b_normal_n",
-                    "host_jaw_b_friction_n"]
+                    "host_jaw_b_friction_n", "friction_n"]
 
 
 def read_trace(path):
@@ -48,6 +48,8 @@ def build_figure(columns, title=""):
     axes[0].plot(t, columns["force_n"], label="commanded |F| (device)", lw=1.0)
     axes[0].plot(t, columns["contact_force_n"], label="proxy |F| (before safety)", lw=0.8, ls="--")
     axes[0].plot(t, columns["host_force_n"], label="host |F| (last host step)", lw=0.8, alpha=0.7)
+    if any(v > 0.0 for v in columns.get("friction_n", [])):
+        axes[0].plot(t, columns["friction_n"], label="of which friction (rt)", lw=0.9, ls=":")
     axes[0].set_ylabel("force [N]")
     axes[0].legend(loc="upper right", fontsize="small")
     axes[1].plot(t, [1e3 * v for v in columns["penetration_m"]], label="contact depth (rt, proxy)", lw=1.0)
