@@ -68,8 +68,8 @@ struct ProxyPartMotion {
   /// The host's friction force on each part at this step (in-solver friction; zero without).
   std::array<Eigen::Vector3d, 3> friction_force_world_n{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
                                                         Eigen::Vector3d::Zero()};
-  /// Velocity of the tissue surface under each part (contact-force-weighted mean of the contacted
-  /// triangles' node velocities): rt_core's stick anchor moves with it between host steps.
+  /// Velocity of the tissue surface under each part (the session's estimate: the contacted nodes'
+  /// velocity, force-weighted and low-passed): rt_core's stick anchor moves with it.
   std::array<Eigen::Vector3d, 3> surface_velocity_world_m_per_s{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
                                                                 Eigen::Vector3d::Zero()};
 };
