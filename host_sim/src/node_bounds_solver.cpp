@@ -63,6 +63,7 @@ void NodeBoundsSolver::solve_with_bounds(btSoftBody& sb) {
   //    (drift: excluded above; dampClusters / applyClusters(true): no-ops without clusters, and
   //    already run in step 1).
   take_bounds(sb, true);
+  for (SoftContactConstraint* contact : contacts_) contact->end_solve(sb);
 }
 
 void NodeBoundsSolver::take_bounds(btSoftBody& sb, bool velocity_update) {

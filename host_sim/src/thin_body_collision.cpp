@@ -126,6 +126,13 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision, public SoftContact
     report_.seconds_response += seconds_between(t0, Clock::now());
   }
 
+  void end_solve(btSoftBody& soft) override {
+    if (!solved_ || !report_.broad_phase_hit || &soft != soft_) return;
+    const Clock::time_point t0 = Clock::now();
+    thin_body::inelastic_rim_velocities(frame_, soft, data_);
+    report_.seconds_response += seconds_between(t0, Clock::now());
+  }
+
   void reset_rest_state(const btSoftBody& soft) override {
     if (&soft != soft_) throw std::invalid_argument("thin-body collision: reset_rest_state() got a different soft body");
     thin_body::take_rest_state(soft, model_.soft);

@@ -164,6 +164,8 @@ void allocate_collision_data(const CollisionModel& model, CollisionData& data) {
   data.friction_anchor_stamp.assign(soft_nodes, -1);
   data.friction_correction_tool_m.assign(soft_nodes, Eigen::Vector3d::Zero());
   data.friction_sliding.assign(soft_nodes, 0);
+  data.rim_correction_world_m.assign(soft_nodes, Eigen::Vector3d::Zero());
+  data.rim_correction_stamp.assign(soft_nodes, -1);
   data.candidate_nodes.clear();
   data.candidate_nodes.reserve(soft_nodes);
   data.sweep_plane_had_contact.assign(model.tool.planes().size(), 0);

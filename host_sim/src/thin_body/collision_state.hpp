@@ -133,6 +133,10 @@ struct CollisionData {
   std::vector<std::int64_t> friction_anchor_stamp;
   std::vector<Eigen::Vector3d> friction_correction_tool_m;
   std::vector<std::uint8_t> friction_sliding;
+  // In-solver rim constraint: the displacement its projections gave a node this step (world, m),
+  // valid at rim_correction_stamp.
+  std::vector<Eigen::Vector3d> rim_correction_world_m;
+  std::vector<std::int64_t> rim_correction_stamp;
   // Node sweep (node_sweep.cpp), per tool plane: a node of it was in contact last step / the
   // current triangle may touch a node of it.
   std::vector<std::uint8_t> sweep_plane_had_contact;
@@ -261,6 +265,9 @@ struct TriangleToolExtent {
 TriangleToolExtent triangle_tool_extent(const ToolNodes& tool, const std::array<Eigen::Vector3d, 3>& x, const Eigen::Vector3d& normal,
                                         double reach_m);
 int project_rim_contacts(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft, CollisionData& data);
+// After the solve's velocity update: a corner the rim constraint pushed this step leaves it no
+// faster along that push than the tool moves there (the contact is inelastic).
+void inelastic_rim_velocities(const StepFrame& frame, btSoftBody& soft, const CollisionData& data);
 void take_solved_shares(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data);
 // After the solve, with friction: the friction force on the tool, the reaction to every candidate's
 // friction impulse this step (m·correction/h²), and how many held nodes stuck and slid.

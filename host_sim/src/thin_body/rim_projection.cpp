@@ -211,11 +211,46 @@ int project_rim_contacts(const CollisionModel& model, const StepFrame& frame, bt
     }
     for (std::size_t k = 0; k < 3; ++k) {
       if (inverse_mass[k] == 0.0 || w[k] == 0.0) continue;
-      write_tool_position(frame, triangle.x[k] - triangle.normal * (depth_m * w[k] * inverse_mass[k] / weight_sum), soft.m_nodes[nodes[k]].m_x);
+      const Eigen::Vector3d move_tool = -triangle.normal * (depth_m * w[k] * inverse_mass[k] / weight_sum);
+      write_tool_position(frame, triangle.x[k] + move_tool, soft.m_nodes[nodes[k]].m_x);
+      const auto n = static_cast<std::size_t>(nodes[k]);
+      if (data.rim_correction_stamp[n] != frame.step) {
+        data.rim_correction_stamp[n] = frame.step;
+        data.rim_correction_world_m[n].setZero();
+      }
+      data.rim_correction_world_m[n] += frame.r_cur * move_tool;
     }
     ++projected;
   }
   return projected;
+}
+
+// Why: Bullet derives the velocity from the solved positions, v = (x − q)/h, so the rim's push —
+// up to a tool thickness, and on a coarse shell several millimetres at a free corner — became a
+// velocity away from the tool of that push per step. The corner flew off the rim in the next step,
+// the links pulled it back onto it, the rim pushed again: a limit cycle of 2–4 steps with the
+// contact set changing on every step (the edge-first blade on the 128-face ball). Kept as a
+// position correction only (as split-impulse position correction does for rigid contacts), the
+// push leaves the corner no faster along it than the tool moves there, so a corner the tool
+// carries keeps the tool's speed, and a resting one stays at rest.
+void inelastic_rim_velocities(const StepFrame& frame, btSoftBody& soft, const CollisionData& data) {
+  for (const int node : data.candidate_nodes) {
+    const auto n = static_cast<std::size_t>(node);
+    if (data.rim_correction_stamp[n] != frame.step) continue;
+    const Eigen::Vector3d& push_m = data.rim_correction_world_m[n];
+    const double push_length_m = push_m.norm();
+    if (!(push_length_m > 0.0)) continue;
+    const Eigen::Vector3d direction = push_m / push_length_m;
+    btSoftBody::Node& soft_node = soft.m_nodes[node];
+    const Eigen::Vector3d x_world(soft_node.m_x.x(), soft_node.m_x.y(), soft_node.m_x.z());
+    const Eigen::Vector3d v_world(soft_node.m_v.x(), soft_node.m_v.y(), soft_node.m_v.z());
+    const Eigen::Vector3d tool_velocity = frame.velocity_world_m_s + frame.angular_velocity_world.cross(x_world - frame.t_cur);
+    const double along_m_s = v_world.dot(direction);
+    const double allowed_m_s = std::max(0.0, tool_velocity.dot(direction));
+    if (along_m_s <= allowed_m_s) continue;
+    const Eigen::Vector3d removed = (along_m_s - allowed_m_s) * direction;
+    soft_node.m_v -= btVector3(static_cast<btScalar>(removed.x()), static_cast<btScalar>(removed.y()), static_cast<btScalar>(removed.z()));
+  }
 }
 
 }  // namespace fissure::host::thin_body

@@ -65,6 +65,9 @@ class SoftContactConstraint {
   virtual void begin_solve(btSoftBody& soft) = 0;
   // After every position iteration: put the contacts' nodes back where the contact allows them.
   virtual void project(btSoftBody& soft) = 0;
+  // After the solve's velocity update (m_v = (m_x − m_q)/h): what the contact's projections should
+  // not leave in the velocity.
+  virtual void end_solve(btSoftBody& /*soft*/) {}
 };
 
 class NodeBoundsSolver : public btDefaultSoftBodySolver {
