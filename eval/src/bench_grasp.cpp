@@ -4,6 +4,7 @@
 // out, and the pull-out force grows with the grip force with slope 2μ within 10 %.
 #include "fissure/eval/bench_grasp.hpp"
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -25,6 +26,8 @@ constexpr double kSlipperyRatio = 0.05;
 // "Slips out": the vessel ends the hold having risen less than half as far as the jaws.
 constexpr double kSlippedRiseShare = 0.5;
 constexpr double kSlopeBound = 0.10;
+// Settle times besides the scene's 0.5 s the lift runs again with (bench_grasp says why).
+constexpr std::array<double, 4> kLiftSettleTimes_s{0.4, 0.45, 0.55, 0.6};
 constexpr double kPullFrictionRatio = 0.3;
 // Drag felt: rt_core's rendered tangential force is μ·F_n within 10 % (median over the slide).
 constexpr double kDragBound = 0.10;
@@ -76,8 +79,31 @@ nlohmann::json run_bench_grasp(const BenchGraspOptions& options) {
   print_lift("slippery", slippery, slippery_wall);
   out["lift"] = lift_json(shipped, shipped_wall);
   out["lift_slippery"] = lift_json(slippery, slippery_wall);
-  checks.push_back(check("lift: vessel rise shortfall, max over the hold [m]", shipped.rise_shortfall_max_m, kRiseBound_m,
-                         shipped.rise_shortfall_max_m <= kRiseBound_m && shipped.jaw_rise_m > 0.0, "jaw rise − vessel rise since closing"));
+  // The take-up at the start of the lift depends on where the settled shell happens to lie when
+  // the jaws close (docs/decisions.md, "Friction and grasp"): one settle time would report a lucky
+  // or an unlucky grasp, so the target is checked on the worst of five.
+  double shortfall_worst_m = shipped.rise_shortfall_max_m;
+  double shortfall_best_m = shipped.rise_shortfall_max_m;
+  bool rose = shipped.jaw_rise_m > 0.0;
+  nlohmann::json settle_runs = nlohmann::json::array();
+  settle_runs.push_back({{"settle_s", lift.settle_s}, {"rise_shortfall_max_m", shipped.rise_shortfall_max_m}});
+  if (!options.quick) {
+    GraspLiftOptions resettled = lift;
+    resettled.friction_ratio_override = -1.0;
+    for (const double settle_s : kLiftSettleTimes_s) {
+      resettled.settle_s = settle_s;
+      const GraspLiftResult r = run_grasp_lift(resettled);
+      shortfall_worst_m = std::max(shortfall_worst_m, r.rise_shortfall_max_m);
+      shortfall_best_m = std::min(shortfall_best_m, r.rise_shortfall_max_m);
+      rose = rose && r.jaw_rise_m > 0.0;
+      settle_runs.push_back({{"settle_s", settle_s}, {"rise_shortfall_max_m", r.rise_shortfall_max_m}});
+    }
+    std::printf("  shipped friction, settled %.2f–%.2f s before closing: shortfall %.2f … %.2f mm\n", kLiftSettleTimes_s.front(), kLiftSettleTimes_s.back(),
+                shortfall_best_m * 1e3, shortfall_worst_m * 1e3);
+  }
+  out["lift_settle_times"] = settle_runs;
+  checks.push_back(check("lift: vessel rise shortfall, max over the hold and settle times [m]", shortfall_worst_m, kRiseBound_m,
+                         shortfall_worst_m <= kRiseBound_m && rose, "jaw rise − vessel rise since closing, worst of settle times 0.4–0.6 s"));
   checks.push_back(check("lift: node slide along a jaw during the hold [m]", shipped.hold_slide_max_m, kSlideBound_m,
                          shipped.hold_slide_max_m <= kSlideBound_m && shipped.hold_contact_nodes > 0, "max tangential slide of the nodes on the jaws at the hold's start"));
   checks.push_back(check("lift: 0 N after the jaws clear the vessel [s]", shipped.release_delay_s, kReleaseBound_s,
