@@ -277,6 +277,50 @@ ToolNodes ToolNodes::from_convex_mesh(const ConvexMeshToolShape& shape) {
   return tool;
 }
 
+namespace {
+
+// Median split along the longest side of the midpoints' box, leaves of up to kLeafEdges edges:
+// balanced, so the depth is log2(edges / kLeafEdges) + 1.
+constexpr int kLeafEdges = 4;
+
+void build_ball(const std::vector<Eigen::Vector3d>& midpoints, const std::vector<double>& half_lengths, std::vector<int>& order,
+                std::vector<ToolNodes::FeatureEdgeBall>& balls, std::size_t ball, int begin, int end, int depth) {
+  if (depth > ToolNodes::kFeatureEdgeBallDepth) throw std::invalid_argument("tool mesh: too many feature edges for the rim's ball tree");
+  Eigen::AlignedBox3d box;
+  for (int i = begin; i < end; ++i) box.extend(midpoints[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])]);
+  const Eigen::Vector3d centre = box.center();
+  double radius_m = 0.0;
+  for (int i = begin; i < end; ++i) {
+    const auto e = static_cast<std::size_t>(order[static_cast<std::size_t>(i)]);
+    radius_m = std::max(radius_m, (midpoints[e] - centre).norm() + half_lengths[e]);
+  }
+  balls[ball] = ToolNodes::FeatureEdgeBall{centre, radius_m, -1, begin, end};
+  if (end - begin <= kLeafEdges) return;
+  int axis = 0;
+  box.sizes().maxCoeff(&axis);
+  const int middle = begin + (end - begin) / 2;
+  std::nth_element(order.begin() + begin, order.begin() + middle, order.begin() + end, [&](int a, int b) {
+    return midpoints[static_cast<std::size_t>(a)][axis] < midpoints[static_cast<std::size_t>(b)][axis];
+  });
+  const std::size_t child = balls.size();
+  balls.resize(child + 2);
+  balls[ball].first_child = static_cast<int>(child);
+  build_ball(midpoints, half_lengths, order, balls, child, begin, middle, depth + 1);
+  build_ball(midpoints, half_lengths, order, balls, child + 1, middle, end, depth + 1);
+}
+
+void build_feature_edge_balls(const std::vector<Eigen::Vector3d>& midpoints, const std::vector<double>& half_lengths, std::vector<int>& order,
+                              std::vector<ToolNodes::FeatureEdgeBall>& balls) {
+  order.resize(midpoints.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  balls.clear();
+  if (order.empty()) return;
+  balls.resize(1);
+  build_ball(midpoints, half_lengths, order, balls, 0, 0, static_cast<int>(order.size()), 1);
+}
+
+}  // namespace
+
 void ToolNodes::finish_pairing() {
   feature_edge_midpoints_tool_m_.clear();
   feature_edge_half_lengths_m_.clear();
@@ -284,6 +328,7 @@ void ToolNodes::finish_pairing() {
     feature_edge_midpoints_tool_m_.push_back(0.5 * (edge[0] + edge[1]));
     feature_edge_half_lengths_m_.push_back(0.5 * (edge[1] - edge[0]).norm());
   }
+  build_feature_edge_balls(feature_edge_midpoints_tool_m_, feature_edge_half_lengths_m_, feature_edge_ball_order_, feature_edge_balls_);
   const int count = node_count();
   paired_by_begin_.assign(static_cast<std::size_t>(count + 1), 0);
   for (const int pair : pair_of_)

@@ -6,8 +6,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 namespace fissure::host {
 namespace {
@@ -194,6 +196,50 @@ TEST(RoundedSpatulaMesh, IsAClosedConvexThinMeshWithManyRimTriangles) {
   }
   EXPECT_GT(edge, 0);
   EXPECT_EQ(tool.edge_node_count(), edge);
+}
+
+// The rim's ball tree over feature edges: every edge sits in exactly one leaf, every ball holds
+// its edges and its children whole (so a ball that misses a query holds nothing that meets it),
+// and the depth stays within the traversal's fixed stack.
+TEST(ToolNodesConvexMesh, FeatureEdgeBallTreeHoldsEveryEdgeWhole) {
+  RoundedSpatulaParams params;
+  params.thickness_m = kThickness_m;
+  for (const ToolNodes& tool : {ToolNodes::from_convex_mesh(make_rounded_spatula_mesh(params, 3.0 * kThickness_m)),
+                                ToolNodes::from_box(plate_shape())}) {
+    const auto& edges = tool.feature_edges_tool_m();
+    const auto& balls = tool.feature_edge_balls();
+    const auto& order = tool.feature_edge_ball_order();
+    ASSERT_FALSE(balls.empty());
+    ASSERT_EQ(order.size(), edges.size());
+    std::vector<int> seen(edges.size(), 0);
+    const double slack_m = 1e-12;
+    struct Visit { int ball; int depth; };
+    std::vector<Visit> pending{{0, 1}};
+    int deepest = 0;
+    while (!pending.empty()) {
+      const Visit visit = pending.back();
+      pending.pop_back();
+      deepest = std::max(deepest, visit.depth);
+      const auto& ball = balls[static_cast<std::size_t>(visit.ball)];
+      for (int i = ball.begin; i < ball.end; ++i) {
+        const auto& edge = edges[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
+        EXPECT_LE((edge[0] - ball.centre_tool_m).norm(), ball.radius_m + slack_m);
+        EXPECT_LE((edge[1] - ball.centre_tool_m).norm(), ball.radius_m + slack_m);
+      }
+      if (ball.first_child < 0) {
+        for (int i = ball.begin; i < ball.end; ++i) ++seen[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
+        continue;
+      }
+      for (int child = ball.first_child; child <= ball.first_child + 1; ++child) {
+        const auto& inner = balls[static_cast<std::size_t>(child)];
+        EXPECT_GE(inner.begin, ball.begin);
+        EXPECT_LE(inner.end, ball.end);
+        pending.push_back({child, visit.depth + 1});
+      }
+    }
+    for (std::size_t e = 0; e < seen.size(); ++e) EXPECT_EQ(seen[e], 1) << "feature edge " << e;
+    EXPECT_LE(deepest, ToolNodes::kFeatureEdgeBallDepth);
+  }
 }
 
 // The paper's Fig. 2 problem and its fix: with an unlimited ray, rim nodes pair with nodes on the

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <tuple>
 
 namespace fissure::host::thin_body {
 namespace {
@@ -97,7 +98,7 @@ CollisionModel build_collision_model(const ToolNodes& tool, const btSoftBody& so
   if (!(hc.k >= 0.0) || !(hc.lambda >= 0.0) || !(hc.n > 0.0) || !std::isfinite(hc.k) || !std::isfinite(hc.lambda) ||
       !std::isfinite(hc.n))
     throw std::invalid_argument("thin-body collision: Hunt-Crossley k, lambda >= 0 and n > 0 (finite)");
-  CollisionModel model{tool, build_bins(tool), SoftSurfaceModel{}, params, paired, 0.0, Eigen::Vector3d::Zero(), 0.0, {}};
+  CollisionModel model{tool, build_bins(tool), SoftSurfaceModel{}, params, paired, 0.0, Eigen::Vector3d::Zero(), 0.0, {}, 0.0, {}};
   prepare_node_sweep(model.tool, model.bins);
   SoftSurfaceModel& surface = model.soft;
   surface.node_count = soft.m_nodes.size();
@@ -132,7 +133,25 @@ CollisionModel build_collision_model(const ToolNodes& tool, const btSoftBody& so
   for (int i = 0; i < tool.node_count(); ++i)
     if (tool.edge_node_flags()[static_cast<std::size_t>(i)] != 0)
       model.rim_plane[static_cast<std::size_t>(tool.plane_of_node()[static_cast<std::size_t>(i)])] = 1;
+  // Sorted and deduplicated (n log n: a fine convex mesh has 10⁴–10⁵ feature edges).
+  for (const auto& edge : tool.feature_edges_tool_m())
+    for (const Eigen::Vector3d& end : edge) model.tool_corners_tool_m.push_back(end);
+  const auto lexicographic = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    return std::tie(a.x(), a.y(), a.z()) < std::tie(b.x(), b.y(), b.z());
+  };
+  std::sort(model.tool_corners_tool_m.begin(), model.tool_corners_tool_m.end(), lexicographic);
+  model.tool_corners_tool_m.erase(std::unique(model.tool_corners_tool_m.begin(), model.tool_corners_tool_m.end()), model.tool_corners_tool_m.end());
   return model;
+}
+
+ToolHeightRange tool_height_range(const CollisionModel& model, const Eigen::Vector3d& origin, const Eigen::Vector3d& normal) {
+  ToolHeightRange range;
+  for (const Eigen::Vector3d& corner : model.tool_corners_tool_m) {
+    const double h = normal.dot(corner - origin);
+    range.lowest_m = std::min(range.lowest_m, h);
+    range.highest_m = std::max(range.highest_m, h);
+  }
+  return range;
 }
 
 void allocate_collision_data(const CollisionModel& model, CollisionData& data) {

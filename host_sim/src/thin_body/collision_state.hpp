@@ -86,7 +86,20 @@ struct CollisionModel {
   // + skin, plus solver_reach_m for the in-solver response (nodes Bullet's iterations may pull
   // into the tool after the detection ran on the predicted positions).
   double near_pad_m = 0.0;
+  // The tool's corners (the feature edges' end points, each once, tool frame): a convex tool's
+  // extent along any direction is reached at one of them, so the rim stages reject a soft
+  // triangle whose plane the tool does not cross with a few dot products instead of the exact
+  // prism clip over every feature edge.
+  std::vector<Eigen::Vector3d> tool_corners_tool_m;
 };
+
+// The tool's lowest and highest height above a plane through `origin` with unit `normal` (tool
+// frame): its support along ±normal, over the corners.
+struct ToolHeightRange {
+  double lowest_m = std::numeric_limits<double>::infinity();
+  double highest_m = -std::numeric_limits<double>::infinity();
+};
+ToolHeightRange tool_height_range(const CollisionModel& model, const Eigen::Vector3d& origin, const Eigen::Vector3d& normal);
 
 // Per-step frame quantities.
 struct StepFrame {

@@ -104,6 +104,9 @@ void rim_contact_forces(const CollisionModel& model, const StepFrame& frame, con
     SoftTriangleInTool triangle;
     if (!soft_triangle_in_tool(model, frame, soft, face, triangle)) continue;
     const Eigen::Vector3d& normal = triangle.normal;
+    // The rim within release_distance in front of the plane needs the tool's lowest corner there.
+    const ToolHeightRange range = tool_height_range(model, triangle.x[0], normal);
+    if (range.lowest_m > release_m || range.highest_m < -band_m) continue;
     const TriangleToolExtent extent = triangle_tool_extent(model.tool, triangle.x, normal, std::max(band_m, release_m));
     if (!extent.meets || extent.lowest_m > release_m || extent.lowest_m < -band_m) continue;
     const double share = release_share(std::max(0.0, extent.lowest_m), release_m);

@@ -143,23 +143,40 @@ TriangleToolExtent triangle_tool_extent(const ToolNodes& tool, const std::array<
   const auto& edges = tool.feature_edges_tool_m();
   const auto& midpoints = tool.feature_edge_midpoints_tool_m();
   const auto& half_lengths = tool.feature_edge_half_lengths_m();
-  for (std::size_t e = 0; e < edges.size(); ++e) {
+  const auto& balls = tool.feature_edge_balls();
+  const auto& order = tool.feature_edge_ball_order();
+  const auto test_edge = [&](std::size_t e) {
     // Every point of the edge lies within half its length of its midpoint: a midpoint farther than
     // radius + that from the normal line leaves the whole edge outside the cylinder (the slack
     // keeps rounding from dropping an edge the exact test below would keep).
     const double reach = radius_m + half_lengths[e] + kInsideTolerance_m;
-    if (across(midpoints[e]).squaredNorm() > reach * reach) continue;
+    if (across(midpoints[e]).squaredNorm() > reach * reach) return;
     const auto& edge = edges[e];
     const Eigen::Vector3d a = across(edge[0]);
     const Eigen::Vector3d ab = across(edge[1]) - a;
     const double ab2 = ab.squaredNorm();
     const double t = ab2 > 0.0 ? std::clamp(-a.dot(ab) / ab2, 0.0, 1.0) : 0.0;
-    if ((a + t * ab).squaredNorm() > radius_m * radius_m) continue;
+    if ((a + t * ab).squaredNorm() > radius_m * radius_m) return;
     double t0 = 0.0, t1 = 0.0;
-    if (!clip_to_prism(side_normal, side_origin, edge[0], edge[1], t0, t1)) continue;
+    if (!clip_to_prism(side_normal, side_origin, edge[0], edge[1], t0, t1)) return;
     const Eigen::Vector3d d = edge[1] - edge[0];
     take(edge[0] + t0 * d);
     take(edge[0] + t1 * d);
+  };
+  // The ball tree: a ball that misses the cylinder holds no edge that meets it.
+  std::array<int, ToolNodes::kFeatureEdgeBallDepth + 2> stack{};
+  int top = 0;
+  if (!balls.empty()) stack[static_cast<std::size_t>(top++)] = 0;
+  while (top > 0) {
+    const ToolNodes::FeatureEdgeBall& ball = balls[static_cast<std::size_t>(stack[static_cast<std::size_t>(--top)])];
+    const double reach = radius_m + ball.radius_m + kInsideTolerance_m;
+    if (across(ball.centre_tool_m).squaredNorm() > reach * reach) continue;
+    if (ball.first_child >= 0) {
+      stack[static_cast<std::size_t>(top++)] = ball.first_child + 1;
+      stack[static_cast<std::size_t>(top++)] = ball.first_child;
+      continue;
+    }
+    for (int i = ball.begin; i < ball.end; ++i) test_edge(static_cast<std::size_t>(order[static_cast<std::size_t>(i)]));
   }
   for (std::size_t k = 0; k < 3; ++k) {
     double s0 = 0.0, s1 = 0.0;
@@ -189,6 +206,10 @@ int project_rim_contacts(const CollisionModel& model, const StepFrame& frame, bt
     if (body_inverse_mass[0] + body_inverse_mass[1] + body_inverse_mass[2] == 0.0) continue;
     SoftTriangleInTool triangle;
     if (!soft_triangle_in_tool(model, frame, soft, face, triangle)) continue;
+    // A cut needs the tool on both sides of the triangle's plane: most candidates lie wholly on
+    // one side, and the corners say so without the prism clip.
+    const ToolHeightRange range = tool_height_range(model, triangle.x[0], triangle.normal);
+    if (!(range.lowest_m < -tolerance_m && range.highest_m > tolerance_m)) continue;
     const TriangleToolExtent extent = triangle_tool_extent(model.tool, triangle.x, triangle.normal, band_m);
     const double lowest_m = extent.lowest_m;
     // Cut: the tool is on both sides of the plane inside the prism, no deeper than the band.

@@ -114,6 +114,20 @@ class ToolNodes {
   // Per feature edge: its midpoint and half its length (the ball round it), for a cheap first test.
   [[nodiscard]] const std::vector<Eigen::Vector3d>& feature_edge_midpoints_tool_m() const { return feature_edge_midpoints_tool_m_; }
   [[nodiscard]] const std::vector<double>& feature_edge_half_lengths_m() const { return feature_edge_half_lengths_m_; }
+  // A ball tree over the feature edges (each ball holds its edges whole), so that a query along a
+  // line visits the edges near the line rather than all of them (the rounded spatula has ~10³).
+  // A ball with first_child < 0 is a leaf holding feature_edge_ball_order()[begin, end); else its
+  // children are first_child and first_child + 1. Depth ≤ kFeatureEdgeBallDepth.
+  struct FeatureEdgeBall {
+    Eigen::Vector3d centre_tool_m = Eigen::Vector3d::Zero();
+    double radius_m = 0.0;
+    int first_child = -1;
+    int begin = 0;
+    int end = 0;
+  };
+  static constexpr int kFeatureEdgeBallDepth = 48;
+  [[nodiscard]] const std::vector<FeatureEdgeBall>& feature_edge_balls() const { return feature_edge_balls_; }
+  [[nodiscard]] const std::vector<int>& feature_edge_ball_order() const { return feature_edge_ball_order_; }
 
   // Signed distance to the tool's convex volume from a point in the tool frame: max over planes
   // of (n·p − offset). Exact inside (−depth to the nearest face), a lower bound outside.
@@ -139,6 +153,8 @@ class ToolNodes {
   std::vector<std::array<Eigen::Vector3d, 2>> feature_edges_tool_m_;
   std::vector<Eigen::Vector3d> feature_edge_midpoints_tool_m_;
   std::vector<double> feature_edge_half_lengths_m_;
+  std::vector<FeatureEdgeBall> feature_edge_balls_;
+  std::vector<int> feature_edge_ball_order_;
   // Footprint along the thin axis as 2-D half-planes (a·(u,v) ≤ b) of the projected hull.
   std::vector<Eigen::Vector3d> footprint_halfplanes_;
   PairingReport report_;
