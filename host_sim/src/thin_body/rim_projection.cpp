@@ -55,6 +55,27 @@ bool clip_to_prism(const std::array<Eigen::Vector3d, 3>& side_normal, const std:
   return true;
 }
 
+// Whether the line x + s·n meets the box grown by kInsideTolerance_m (slab test). The tool lies in
+// its vertices' box, so a line that misses it misses the tool; the margin keeps rounding from
+// rejecting a line the plane clip would keep.
+bool line_meets_box(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& x, const Eigen::Vector3d& n) {
+  double s0 = -std::numeric_limits<double>::infinity();
+  double s1 = std::numeric_limits<double>::infinity();
+  for (int axis = 0; axis < 3; ++axis) {
+    const double lo = box.min()[axis] - kInsideTolerance_m - x[axis];
+    const double hi = box.max()[axis] + kInsideTolerance_m - x[axis];
+    if (n[axis] == 0.0) {
+      if (lo > 0.0 || hi < 0.0) return false;
+      continue;
+    }
+    const double a = lo / n[axis], b = hi / n[axis];
+    s0 = std::max(s0, std::min(a, b));
+    s1 = std::min(s1, std::max(a, b));
+    if (s0 > s1) return false;
+  }
+  return true;
+}
+
 // The line x + s·n clipped to the tool (every plane: normal·p ≤ offset): false when it misses.
 bool clip_line_to_tool(const std::vector<ToolPlane>& planes, const Eigen::Vector3d& x, const Eigen::Vector3d& n, double& s0, double& s1) {
   s0 = -std::numeric_limits<double>::infinity();
@@ -180,7 +201,7 @@ TriangleToolExtent triangle_tool_extent(const ToolNodes& tool, const std::array<
   }
   for (std::size_t k = 0; k < 3; ++k) {
     double s0 = 0.0, s1 = 0.0;
-    if (!clip_line_to_tool(tool.planes(), x[k], normal, s0, s1)) continue;
+    if (!line_meets_box(tool.bounds_tool_m(), x[k], normal) || !clip_line_to_tool(tool.planes(), x[k], normal, s0, s1)) continue;
     take(x[k] + s0 * normal);
     take(x[k] + s1 * normal);
   }
