@@ -88,5 +88,48 @@ TEST(EnforcedDisplacement, HeldNodeLiftedOffMovesFreelyAndIsHeldAgainWhereItLand
   EXPECT_NEAR(landed.y(), held.y(), 1e-6);
 }
 
+// The rim wrap (a coarse triangle straddling an edge-first blade is pulled in front of the edge)
+// moves a vertex beside the blade onto the leading rim plane. A vertex beyond the tool's back —
+// past the far side face, as the vessel's wall lies beside a clamp jaw's opposite edge — is not
+// beside the blade: its straight move onto the leading rim runs over a large face (so it clears
+// the interior) and across the whole tool. It stays where it is.
+TEST(EnforcedDisplacement, RimWrapNeverCarriesAVertexAcrossTheWholeTool) {
+  // A plate 40 mm along x, 4 mm thick, moving 1 mm per step along +x: its +x side face leads into
+  // one triangle that meets it head-on (outward normal 55° off −x, towards −y) and leans back
+  // over the plate's +y face to a top vertex at height top_y.
+  struct Outcome {
+    Eigen::Vector3d top_start_m;
+    Eigen::Vector3d top_end_m;
+    double rim_x_m = 0.0;
+  };
+  const auto plunge = [](double top_y_m) {
+    test_scene::SoftWorld world{false};
+    const ToolNodes tool = test_scene::plate_tool(0.004);
+    constexpr double kTan55 = 1.4281480067421144;
+    const auto x_at = [&](double y) { return 0.024 - kTan55 * y; };
+    const std::vector<Eigen::Vector3d> vertices = {{x_at(-0.01), -0.01, 0.03}, {x_at(-0.01), -0.01, -0.03}, {x_at(top_y_m), top_y_m, 0.0}};
+    world.add_triangles(vertices, {1, 0, 2});
+    std::unique_ptr<ThinBodyCollision> collision = make_paired_collision(tool, world.soft(), ThinBodyCollisionParams{});
+    CollisionStepResult result;
+    ToolPose previous;
+    previous.position_world_m = Eigen::Vector3d(0.0035, 0.0, 0.0);  // rim 0.5 mm before the triangle at y = 0
+    ToolPose pose = previous;
+    pose.position_world_m.x() += 0.001;
+    world.step_without_dynamics();
+    collision->step(previous, pose, test_scene::kStep_s, world.soft(), result);
+    return Outcome{vertices[2], to_eigen(world.soft().m_nodes[2].m_x), pose.position_world_m.x() + 0.02};
+  };
+  const double skin_m = ThinBodyCollisionParams{}.skin_m;
+  // Top vertex 15 mm up: beside the plate (2 mm behind its middle), wrapped onto the leading rim.
+  const Outcome beside = plunge(0.015);
+  EXPECT_NEAR(beside.top_end_m.x(), beside.rim_x_m + skin_m, 1e-6) << "a vertex beside the plate is wrapped in front of its rim";
+  EXPECT_NEAR(beside.top_end_m.y(), beside.top_start_m.y(), 1e-6);
+  // Top vertex 40 mm up: 38 mm behind the plate's middle, 18 mm beyond its back face.
+  const Outcome beyond = plunge(0.04);
+  EXPECT_LT(beyond.top_start_m.x() - (beyond.rim_x_m - 0.04), 0.0) << "the premise: beyond the back face";
+  EXPECT_NEAR(beyond.top_end_m.x(), beyond.top_start_m.x(), 1e-6) << "a vertex beyond the back is not carried across the plate";
+  EXPECT_NEAR(beyond.top_end_m.y(), beyond.top_start_m.y(), 1e-6);
+}
+
 }  // namespace
 }  // namespace fissure::host

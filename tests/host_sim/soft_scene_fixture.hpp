@@ -103,6 +103,17 @@ class SoftWorld {
     soft_->getCollisionShape()->setMargin(0.002f);
   }
 
+  // A soft surface of the given triangles (xyz per vertex, three indices per triangle), 0.1 kg.
+  void add_triangles(const std::vector<Eigen::Vector3d>& vertices_m, const std::vector<int>& triangles) {
+    std::vector<btScalar> flat;
+    for (const Eigen::Vector3d& v : vertices_m)
+      for (int axis = 0; axis < 3; ++axis) flat.push_back(static_cast<btScalar>(v[axis]));
+    adopt(btSoftBodyHelpers::CreateFromTriMesh(world_.getWorldInfo(), flat.data(), triangles.data(),
+                                               static_cast<int>(triangles.size() / 3), false));
+    soft_->setTotalMass(0.1f, true);
+    soft_->getCollisionShape()->setMargin(0.002f);
+  }
+
   // One Bullet step (ONE substep, as the collision's call order requires).
   void step_dynamics(double dt_s = kStep_s) {
     world_.stepSimulation(static_cast<btScalar>(dt_s), 1, static_cast<btScalar>(dt_s));

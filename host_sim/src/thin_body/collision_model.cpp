@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <tuple>
 
@@ -98,7 +99,7 @@ CollisionModel build_collision_model(const ToolNodes& tool, const btSoftBody& so
   if (!(hc.k >= 0.0) || !(hc.lambda >= 0.0) || !(hc.n > 0.0) || !std::isfinite(hc.k) || !std::isfinite(hc.lambda) ||
       !std::isfinite(hc.n))
     throw std::invalid_argument("thin-body collision: Hunt-Crossley k, lambda >= 0 and n > 0 (finite)");
-  CollisionModel model{tool, build_bins(tool), SoftSurfaceModel{}, params, paired, 0.0, Eigen::Vector3d::Zero(), 0.0, {}, 0.0, {}};
+  CollisionModel model{tool, build_bins(tool), SoftSurfaceModel{}, params, paired, 0.0, Eigen::Vector3d::Zero(), 0.0, {}, 0.0, {}, {}};
   prepare_node_sweep(model.tool, model.bins);
   SoftSurfaceModel& surface = model.soft;
   surface.node_count = soft.m_nodes.size();
@@ -141,6 +142,9 @@ CollisionModel build_collision_model(const ToolNodes& tool, const btSoftBody& so
   };
   std::sort(model.tool_corners_tool_m.begin(), model.tool_corners_tool_m.end(), lexicographic);
   model.tool_corners_tool_m.erase(std::unique(model.tool_corners_tool_m.begin(), model.tool_corners_tool_m.end()), model.tool_corners_tool_m.end());
+  model.rim_plane_back_m.assign(tool.planes().size(), -std::numeric_limits<double>::infinity());
+  for (std::size_t q = 0; q < tool.planes().size(); ++q)
+    if (model.rim_plane[q] != 0) model.rim_plane_back_m[q] = tool_height_range(model, Eigen::Vector3d::Zero(), tool.planes()[q].normal_tool).lowest_m;
   return model;
 }
 

@@ -91,6 +91,10 @@ struct CollisionModel {
   // triangle whose plane the tool does not cross with a few dot products instead of the exact
   // prism clip over every feature edge.
   std::vector<Eigen::Vector3d> tool_corners_tool_m;
+  // Per rim plane: the tool's lowest height along the plane's normal (its back, the far side of
+  // the tool seen from that rim). A node below it is beyond the tool, not beside it, and is never
+  // wrapped onto the rim (enforced_displacement.cpp). −∞ for the other planes.
+  std::vector<double> rim_plane_back_m;
 };
 
 // The tool's lowest and highest height above a plane through `origin` with unit `normal` (tool

@@ -103,11 +103,15 @@ struct Writer {
   // plane has no opposite face and no pair to say which side the soft body is on; geometry does:
   // a vertex beside a blade (outside its slab), even behind the rim, is pulled onto the rim plane
   // without passing through the tool, so a coarse triangle straddling the blade is wrapped in
-  // front of the edge instead of being sliced by it.
+  // front of the edge instead of being sliced by it. A vertex beyond the tool's back along the
+  // rim's normal is on the tool's far side (past a jaw's opposite side face): its straight move
+  // onto this rim would carry it across the whole tool — over a large face, so it clears the
+  // interior — and is no wrap.
   bool move_clears_tool(int node, int plane_index) const {
     const ToolPlane& target_plane = model.tool.planes()[static_cast<std::size_t>(plane_index)];
     const Eigen::Vector3d& a = data.end_tool_m[static_cast<std::size_t>(node)];
     if (target_plane.normal_tool.dot(a) >= target_plane.offset_m + model.params.skin_m) return true;  // in front: nothing to move
+    if (target_plane.normal_tool.dot(a) <= model.rim_plane_back_m[static_cast<std::size_t>(plane_index)]) return false;
     return segment_clears_tool(model.tool.planes(), a, target_on_plane(node, plane_index));
   }
 
