@@ -16,6 +16,7 @@ void register_bench_collision(CommandTree& tree) {
   struct Arguments {
     std::string json_path;
     std::string contact_response = "after_step";
+    std::string in_solver_friction = "on";
     eval::BenchCollisionOptions bench;
   };
   auto a = std::make_shared<Arguments>();
@@ -29,7 +30,12 @@ void register_bench_collision(CommandTree& tree) {
                   "Where the paired / ray response acts in every scene: after_step (after Bullet's step) or in_solver (inside its position iterations)")
       ->check(CLI::IsMember({host::to_string(host::ContactResponse::kAfterStep), host::to_string(host::ContactResponse::kInSolver)}))
       ->capture_default_str();
+  cmd->add_option("--in-solver-friction", a->in_solver_friction,
+                  "In-solver plunge and levering cells: the tool's faces have friction 0.5 / 0.4 (on) or none (off)")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
   cmd->callback([a] {
+    a->bench.in_solver_tool_friction = a->in_solver_friction == "on";
     a->bench.contact_response = *host::parse_contact_response(a->contact_response);  // IsMember checked the name
     write_json_file(a->json_path, eval::run_bench_collision(a->bench));
     std::printf("\nwrote %s\n", a->json_path.c_str());

@@ -71,11 +71,11 @@ SceneDescription with_response(SceneDescription scene, host::ContactResponse res
   return scene;
 }
 
-// A plunge cell's scene: in_solver runs the tests' in-solver cells (tool friction, ball on its
-// bed: host::in_solver_plunge_scene).
-SceneDescription plunge_cell_scene(const host::PlungeTool& tool, int icosphere_faces, host::ContactResponse response) {
+// A plunge cell's scene: in_solver runs the tests' in-solver cells (tool friction unless
+// switched off, ball on its bed: host::in_solver_plunge_scene).
+SceneDescription plunge_cell_scene(const host::PlungeTool& tool, int icosphere_faces, host::ContactResponse response, bool tool_friction) {
   const SceneDescription scene = host::plunge_scene(tool, icosphere_faces);
-  return response == host::ContactResponse::kInSolver ? host::in_solver_plunge_scene(scene) : with_response(scene, response);
+  return response == host::ContactResponse::kInSolver ? host::in_solver_plunge_scene(scene, tool_friction) : with_response(scene, response);
 }
 
 // Least-squares slope of log F against log d (points with F > 0).
@@ -158,13 +158,13 @@ void print_sweep_legend(double hold_s) {
 
 // One sweep table: every tool × method × speed on the ball of `icosphere_faces` (0: the paper's 128-face shell).
 nlohmann::json sweep_cells(const std::vector<double>& speeds, const std::vector<SceneCollisionMethod>& methods, int icosphere_faces, double hold_s,
-                           host::ContactResponse response, const char* progress_name) {
+                           host::ContactResponse response, bool tool_friction, const char* progress_name) {
   const auto& tools = host::plunge_tools();
   nlohmann::json sweep = nlohmann::json::array();
   SimProgress progress(progress_name, static_cast<long>(speeds.size() * tools.size() * methods.size()));
   long done = 0;
   for (const host::PlungeTool& tool : tools) {
-    const SceneDescription scene = plunge_cell_scene(tool, icosphere_faces, response);
+    const SceneDescription scene = plunge_cell_scene(tool, icosphere_faces, response, tool_friction);
     const std::string tool_name(tool.name);
     for (SceneCollisionMethod method : methods) {
       for (double v : speeds) {
@@ -207,13 +207,14 @@ void run_sweep(const BenchCollisionOptions& o, nlohmann::json& out) {
                        {"hold_settle_s", host::kHoldSettle_s}};
   print_sweep_legend(hold_s);
   out["sweep"] = sweep_cells(speeds, {SceneCollisionMethod::kBullet, SceneCollisionMethod::kRay, SceneCollisionMethod::kPaired}, 0, hold_s,
-                             o.contact_response, "bench collision: sweep");
+                             o.contact_response, o.in_solver_tool_friction, "bench collision: sweep");
   std::printf("\n1b. The same paired cells on a %d-face icosphere (issue 22's second mesh)\n", kFineSweepFaces);
   out["sweep_fine_body"] = {{"faces", kFineSweepFaces}, {"tessellation", "icosphere"}, {"shape_matching_ratio", kShapeMatchingRatio},
                             {"plunge_depth_m", host::kPlungeDepth_m}, {"hold_s", hold_s}, {"hold_settle_s", host::kHoldSettle_s}};
   print_sweep_legend(hold_s);
   out["sweep_fine"] =
-      sweep_cells(speeds, {SceneCollisionMethod::kPaired}, kFineSweepFaces, hold_s, o.contact_response, "bench collision: sweep, 1280 faces");
+      sweep_cells(speeds, {SceneCollisionMethod::kPaired}, kFineSweepFaces, hold_s, o.contact_response, o.in_solver_tool_friction,
+                  "bench collision: sweep, 1280 faces");
 }
 
 // ---- 1c. Levering and clamp-release cells (issue 22) -------------------------------------------
@@ -226,7 +227,7 @@ void run_motion_cells(const BenchCollisionOptions& o, nlohmann::json& out) {
               "F_hold N", "jitter%", "step%");
   nlohmann::json lever = nlohmann::json::array();
   for (const int faces : {0, kFineSweepFaces}) {
-    const SceneDescription scene = plunge_cell_scene(host::plunge_tools()[2], faces, o.contact_response);
+    const SceneDescription scene = plunge_cell_scene(host::plunge_tools()[2], faces, o.contact_response, o.in_solver_tool_friction);
     for (SceneCollisionMethod method : {SceneCollisionMethod::kBullet, SceneCollisionMethod::kPaired}) {
       const host::LeverResult r = host::run_lever_hold(scene, method, hold_s);
       const int mesh = faces == 0 ? 128 : faces;
@@ -512,6 +513,7 @@ nlohmann::json run_parts(const BenchCollisionOptions& o) {
   // The step times are wall clock on a shared VM: the load says how loaded it was.
   out["load_average_start"] = load_average();
   out["contact_response"] = host::to_string(o.contact_response);
+  out["in_solver_tool_friction"] = o.in_solver_tool_friction;
   const SceneDescription base = with_response(base_scene(), o.contact_response);
   if (o.runs("sweep")) {
     run_sweep(o, out);

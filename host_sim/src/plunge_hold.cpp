@@ -38,10 +38,10 @@ SceneDescription plunge_scene(const PlungeTool& tool, int icosphere_faces) {
   return s;
 }
 
-SceneDescription in_solver_plunge_scene(SceneDescription scene) {
+SceneDescription in_solver_plunge_scene(SceneDescription scene, bool tool_friction) {
   scene.simulation.contact_response = ContactResponse::kInSolver;
-  scene.tool.friction_static_ratio = kPlungeFrictionStaticRatio;
-  scene.tool.friction_kinetic_ratio = kPlungeFrictionKineticRatio;
+  scene.tool.friction_static_ratio = tool_friction ? kPlungeFrictionStaticRatio : 0.0;
+  scene.tool.friction_kinetic_ratio = tool_friction ? kPlungeFrictionKineticRatio : 0.0;
   SoftAnchorBox bed;
   bed.min_world_m = {-1.0, scene.ground.top_height_m - 1.0, -1.0};
   bed.max_world_m = {1.0, scene.ground.top_height_m + kPlungeBedTop_m, 1.0};

@@ -17,6 +17,8 @@ struct BenchCollisionOptions {
   /// Where the paired / ray response acts in every scene the bench runs (the solver A/B of part 4
   /// stays after_step: it compares Bullet's stock solver, which cannot host the in-solver one).
   host::ContactResponse contact_response = host::ContactResponse::kAfterStep;
+  /// In-solver plunge and levering cells: the tool's faces have friction 0.5 / 0.4 (true) or none.
+  bool in_solver_tool_friction = true;
   [[nodiscard]] bool runs(const char* part) const;
 };
 

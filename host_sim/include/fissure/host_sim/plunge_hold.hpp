@@ -69,8 +69,10 @@ inline constexpr double kPlungeFrictionStaticRatio = 0.5;
 inline constexpr double kPlungeFrictionKineticRatio = 0.4;
 /// The bed: the ball's bottom cap, 15 mm high on the 100 mm ball (15 % of its surface).
 inline constexpr double kPlungeBedTop_m = 0.015;
-/// `scene` (a plunge scene) with the in-solver response, the tool's friction and the ball on its bed.
-[[nodiscard]] SceneDescription in_solver_plunge_scene(SceneDescription scene);
+/// `scene` (a plunge scene) with the in-solver response, the tool's friction (none when
+/// `tool_friction` is false: the frictionless cells issue 23 also holds the contact to) and the
+/// ball on its bed.
+[[nodiscard]] SceneDescription in_solver_plunge_scene(SceneDescription scene, bool tool_friction = true);
 
 /// Where a plunge starts: the tool kPlungeStartClearance_m above the settled soft surface, and
 /// the height of its origin once the leading face is kPlungeDepth_m below that surface [m, world y].
