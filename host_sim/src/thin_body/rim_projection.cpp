@@ -98,6 +98,21 @@ bool clip_line_to_tool(const std::vector<ToolPlane>& planes, const Eigen::Vector
   return true;
 }
 
+// Whether a tool plane that one of the triangle's corners is held on this step has all three
+// corners on or in front of it.
+bool separated_by_a_held_plane(const CollisionModel& model, const StepFrame& frame, const CollisionData& data, const std::array<int, 3>& nodes,
+                               const SoftTriangleInTool& triangle) {
+  for (const int node : nodes) {
+    const auto n = static_cast<std::size_t>(node);
+    if (data.hold_stamp[n] != frame.step || data.hold_plane[n] < 0) continue;
+    const ToolPlane& plane = model.tool.planes()[static_cast<std::size_t>(data.hold_plane[n])];
+    if (plane.normal_tool.dot(triangle.x[0]) >= plane.offset_m && plane.normal_tool.dot(triangle.x[1]) >= plane.offset_m &&
+        plane.normal_tool.dot(triangle.x[2]) >= plane.offset_m)
+      return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 bool soft_triangle_in_tool(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, int face, SoftTriangleInTool& out) {
@@ -227,6 +242,11 @@ int project_rim_contacts(const CollisionModel& model, const StepFrame& frame, bt
     if (body_inverse_mass[0] + body_inverse_mass[1] + body_inverse_mass[2] == 0.0) continue;
     SoftTriangleInTool triangle;
     if (!soft_triangle_in_tool(model, frame, soft, face, triangle)) continue;
+    // A tool face plane with all three corners on or in front of it separates the triangle from
+    // the tool; inside the prism the tool then lies on one side of the triangle's plane, so the
+    // triangle is not cut. The planes its corners are held on are the ones to try: a triangle
+    // pressed flat under a face is the common candidate, and this spares it the prism clip.
+    if (separated_by_a_held_plane(model, frame, data, nodes, triangle)) continue;
     // A cut needs the tool on both sides of the triangle's plane: most candidates lie wholly on
     // one side, and the corners say so without the prism clip.
     const ToolHeightRange range = tool_height_range(model, triangle.x[0], triangle.normal);
