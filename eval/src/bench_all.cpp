@@ -79,6 +79,13 @@ std::vector<Child> children(const fs::path& out_dir) {
       // JSON says what could not be had (wakeup_us.*.sched_fifo), instead of no rt figures.
       {"rt", {"bench", "rt"}, {"--rt-policy", "best_effort"}, {"--rt-policy", "best_effort", "--seconds", "3"}, 75, 20},
       {"collision", {"bench", "collision"}, {}, {"--quick"}, 150, 30},
+      // Issue 22's in-solver response (not yet the scenes' default): its sweep and cells with the
+      // tool's friction and without it (issue 23 asks for both).
+      {"collision_in_solver", {"bench", "collision"}, {"--only", "sweep", "--only", "cells", "--contact-response", "in_solver"},
+       {"--quick", "--only", "sweep", "--only", "cells", "--contact-response", "in_solver"}, 45, 10},
+      {"collision_in_solver_frictionless", {"bench", "collision"},
+       {"--only", "sweep", "--only", "cells", "--contact-response", "in_solver", "--in-solver-friction", "off"},
+       {"--quick", "--only", "sweep", "--only", "cells", "--contact-response", "in_solver", "--in-solver-friction", "off"}, 45, 10},
       {"proxy", {"bench", "proxy"}, {}, {"--host-rates", "1000", "100"}, 5, 3},
       // Mesh import load times (issue 24): up to 362k-triangle tools; --quick stops at 41k.
       {"mesh", {"bench", "mesh"}, {}, {"--quick"}, 60, 2},

@@ -4,7 +4,7 @@
 usage: make_report.py DIR [--md FILE] [--images DIR]
 
 DIR holds what `fissure bench all --out DIR` wrote: kinematics.json, rt.json, collision.json,
-proxy.json, pareto.json, view.json, stress.json, mesh.json and bench_all.json (which children ran, their
+collision_in_solver.json, collision_in_solver_frictionless.json, proxy.json, pareto.json, view.json, stress.json, mesh.json and bench_all.json (which children ran, their
 exit codes and wall times). --md (default DIR/report.md) is the report; --images (default DIR)
 receives the PNGs, linked from the report by relative paths, so a report written to
 docs/benchmarks.md with --images docs/images/bench works from docs/.
@@ -18,6 +18,7 @@ import json
 import math
 import os
 import shutil
+import statistics
 import sys
 
 import matplotlib
@@ -26,11 +27,12 @@ matplotlib.use("Agg")  # headless: CI and SSH sessions have no display
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from targets import MET, MISSED, NOT_CHECKED, Target, evaluate_all  # noqa: E402
+from targets import IN_SOLVER_VARIANTS, MET, MISSED, NOT_CHECKED, Target, evaluate_all  # noqa: E402
 
 REGENERATE = "build/bin/fissure bench all --out out/bench --docs docs --stress-full"
 
-BENCHMARKS = ["kinematics", "rt", "collision", "proxy", "pareto", "view", "stress", "stress_full", "mesh", "grasp"]
+BENCHMARKS = ["kinematics", "rt", "collision", "collision_in_solver", "collision_in_solver_frictionless", "proxy", "pareto", "view",
+              "stress", "stress_full", "mesh", "grasp"]
 # `fissure render` children of bench all: one PNG frame each of the 10 m/s plunge.
 PLUNGE_FRAMES = {"plunge_bullet": "plunge-bullet", "plunge_paired": "plunge-paired"}
 
@@ -543,6 +545,65 @@ def section_tunnelling(report, data, problems, targets):
     report.add(targets_table([t for t in targets if t.section == "collision indentation"]))
 
 
+def section_contact_in_solver(report, data, problems, targets):
+    report.add("## Contact inside the solver — `fissure bench collision --contact-response in_solver`")
+    report.add("")
+    report.add("The paired response as constraints inside Bullet's position iterations (issue 22; `[simulation] contact_response = "
+               "\"in_solver\"`, not yet the scenes' default). Its plunge and levering cells tie the ball's bottom cap to the "
+               "ground (a bed); one run gives the tool's faces friction 0.5 / 0.4, the other none (`--in-solver-friction off`). "
+               "The clamp-release cells are clamp-sphere's. Each cell: crossed nodes / hold jitter / step noise / cut triangles "
+               "(most on a hold step · hold steps with any); the median paired step beside Bullet's own on the same cell.")
+    report.add("")
+    for name, variant in IN_SOLVER_VARIANTS.items():
+        report.add(f"### {variant}")
+        report.add("")
+        col = data.get(name)
+        if col is None:
+            missing(report, name, problems)
+            report.add(targets_table([t for t in targets if t.section == ("contact in_solver" if name == "collision_in_solver"
+                                                                           else "contact in_solver frictionless")]))
+            continue
+
+        def cell_text(r):
+            if not r.get("hold_in_contact"):
+                return f"lost, cut {r['hold_max_cut_triangles']}·{r['hold_steps_with_cut_triangles']}"
+            return (f"{r['crossed_nodes']} / {100 * r['force_jitter']:.2f}% / {100 * r['force_step_noise']:.2f}% / "
+                    f"{r['hold_max_cut_triangles']}·{r['hold_steps_with_cut_triangles']}")
+        for key, body in (("sweep", "sweep_body"), ("sweep_fine", "sweep_fine_body")):
+            rows = [r for r in col.get(key) or [] if r["method"] == "paired"]
+            if not rows:
+                continue
+            bullet = {(r["tool"], r["speed_m_s"]): r for r in col.get(key) or [] if r["method"] == "bullet"}
+            cells = {(r["tool"], r["speed_m_s"]): r for r in rows}
+            tools = list(dict.fromkeys(r["tool"] for r in rows))
+            speeds = sorted({r["speed_m_s"] for r in rows})
+            faces = (col.get(body) or {}).get("faces", "?")
+            report.add(f"{faces} faces:")
+            report.add("")
+            table_rows = []
+            for t in tools:
+                steps = [cells[(t, v)]["step_median_us"] for v in speeds if (t, v) in cells]
+                own = [bullet[(t, v)]["step_median_us"] for v in speeds if (t, v) in bullet]
+                cost = f"{statistics.median(steps):.0f}" + (f" / {statistics.median(own):.0f}" if own else "")
+                table_rows.append([t] + [cell_text(cells[(t, v)]) if (t, v) in cells else "—" for v in speeds] + [cost])
+            report.add(table(["tool"] + [f"{v:g} m/s" for v in speeds] + ["step µs paired / bullet"], table_rows))
+        lever = [r for r in col.get("lever") or [] if r["method"] == "paired"]
+        release = [r for r in col.get("clamp_release") or [] if r["method"] == "paired"]
+        if lever:
+            report.add("Levering (the 1 mm blade turned 30° about its edge, held 0.5 s):")
+            report.add("")
+            report.add(table(["mesh faces", "crossed", "cut max / steps", "F_hold N", "jitter", "step noise"],
+                             [[r["faces"], r["crossed_nodes"], f"{r['max_cut_triangles']} / {r['steps_with_cut_triangles']} of {r['steps']}",
+                               f"{r['hold_force_n']:.3f}", "lost" if r.get("force_jitter") is None else f"{100 * r['force_jitter']:.3f} %",
+                               "lost" if r.get("force_step_noise") is None else f"{100 * r['force_step_noise']:.3f} %"] for r in lever]))
+        if release:
+            report.add("Clamp release: " + ", ".join(f"settled {r['settle_s']:g} s → {r['open_force_max_n']:.4f} N open, "
+                                                   f"cut {r['max_cut_triangles']}" for r in release) + ".")
+            report.add("")
+        section = "contact in_solver" if name == "collision_in_solver" else "contact in_solver frictionless"
+        report.add(targets_table([t for t in targets if t.section == section]))
+
+
 def section_scaling(report, data, problems, targets):
     report.add("## Cost against mesh size — `fissure bench collision`")
     report.add("")
@@ -841,7 +902,7 @@ def section_grasp(report, data, problems, targets):
     report.add(targets_table([t for t in targets if t.section == "grasp"]))
 
 
-SECTIONS = [section_pareto, section_tunnelling, section_scaling, section_rt, section_stress, section_view, section_mesh,
+SECTIONS = [section_pareto, section_tunnelling, section_contact_in_solver, section_scaling, section_rt, section_stress, section_view, section_mesh,
             section_grasp]
 
 

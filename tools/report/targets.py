@@ -132,15 +132,22 @@ def zwidth_targets(rt):
 # ---------------------------------------------------------------- contact (issue 22)
 
 CONTACT_SOURCE = "issue 22"
+# The report's in-solver runs of `fissure bench collision` (bench all's children of these names).
+IN_SOLVER_VARIANTS = {"collision_in_solver": "in_solver, tool friction 0.5 / 0.4",
+                      "collision_in_solver_frictionless": "in_solver, frictionless"}
 
 
-def contact_targets(col):
+def contact_targets(col, section="contact", variant="", json_name="collision.json"):
+    """Issue 22's targets over one `fissure bench collision` run; `variant` names the response
+    the run used when it is not the default (the in-solver runs of the report)."""
     d = ["paired: 0 triangles cut deeper than 0.1 mm (both sweep meshes over the hold; levering and clamp cells over every step)",
          "paired: step noise ≤ 0.3 % in every held cell (both meshes, levering)",
          "paired: hold jitter ≤ 1 % up to 10 m/s, ≤ 3 % at 20–50 m/s (both meshes)",
          "an opened jaw carries 0 N within 5 ms at every settling time"]
+    if variant:
+        d = [f"{variant}: {x}" for x in d]
     if col is None or "sweep_fine" not in col:
-        return _absent("contact", d, CONTACT_SOURCE, "no sweep_fine / lever / clamp_release in collision.json")
+        return _absent(section, d, CONTACT_SOURCE, f"no sweep_fine / lever / clamp_release in {json_name}")
     out = []
     coarse = [r for r in col["sweep"] if r["method"] == "paired"]
     fine = col["sweep_fine"]
@@ -152,25 +159,25 @@ def contact_targets(col):
               ("1280-face sweep", cut(fine, "hold_max_cut_triangles"), len(fine)),
               ("levering", cut(lever, "max_cut_triangles"), len(lever)), ("clamp", cut(release, "max_cut_triangles"), len(release))]
     bad = sum(c for _, c, _ in counts)
-    out.append(Target("contact", d[0], "cells with a cut triangle: " + ", ".join(f"{name} {c}/{n}" for name, c, n in counts),
+    out.append(Target(section, d[0], "cells with a cut triangle: " + ", ".join(f"{name} {c}/{n}" for name, c, n in counts),
                       _status(bad == 0), CONTACT_SOURCE))
     held = [r for r in coarse + fine + lever if r.get("force_step_noise") is not None]
     lost = len(coarse) + len(fine) + len(lever) - len(held)
     noisy = [r for r in held if r["force_step_noise"] > 0.003]
     worst = max((r["force_step_noise"] for r in held), default=None)
-    out.append(Target("contact", d[1], f"{len(held) - len(noisy)} of {len(held)} held cells within (worst {_f(100 * worst if worst is not None else None)} %)"
+    out.append(Target(section, d[1], f"{len(held) - len(noisy)} of {len(held)} held cells within (worst {_f(100 * worst if worst is not None else None)} %)"
                       + (f"; {lost} cells lost contact" if lost else ""), _status(not noisy and not lost), CONTACT_SOURCE))
     swept = [r for r in coarse + fine if r.get("force_jitter") is not None]
     over = [r for r in swept if r["force_jitter"] > (0.01 if r["speed_m_s"] <= 10.0 else 0.03)]
     lost_sweep = len(coarse) + len(fine) - len(swept)
-    out.append(Target("contact", d[2], f"{len(swept) - len(over)} of {len(coarse) + len(fine)} cells within"
+    out.append(Target(section, d[2], f"{len(swept) - len(over)} of {len(coarse) + len(fine)} cells within"
                       + (f"; {lost_sweep} lost contact" if lost_sweep else ""), _status(not over and not lost_sweep), CONTACT_SOURCE))
     if release:
         worst_open = max(r["open_force_max_n"] for r in release)
         text = ", ".join(f"{r['settle_s']:g} s: {r['open_force_max_n']:.3f} N" for r in release)
-        out.append(Target("contact", d[3], text, _status(worst_open < 0.01), CONTACT_SOURCE))
+        out.append(Target(section, d[3], text, _status(worst_open < 0.01), CONTACT_SOURCE))
     else:
-        out += _absent("contact", d[3:], CONTACT_SOURCE, "no clamp_release in collision.json")
+        out += _absent(section, d[3:], CONTACT_SOURCE, f"no clamp_release in {json_name}")
     return out
 
 
@@ -440,6 +447,11 @@ def grasp_targets(grasp):
 def evaluate_all(data):
     checks = [("proxy", proxy_targets, "proxy"), ("pareto", pareto_targets, "pareto"),
               ("kinematics", kinematics_targets, "kinematics"), ("collision", collision_targets, "collision"), ("contact", contact_targets, "collision"),
+              ("contact in_solver", lambda c: contact_targets(c, "contact in_solver", IN_SOLVER_VARIANTS["collision_in_solver"],
+                                                              "collision_in_solver.json"), "collision_in_solver"),
+              ("contact in_solver frictionless",
+               lambda c: contact_targets(c, "contact in_solver frictionless", IN_SOLVER_VARIANTS["collision_in_solver_frictionless"],
+                                         "collision_in_solver_frictionless.json"), "collision_in_solver_frictionless"),
               ("rt", rt_targets, "rt"), ("zwidth", zwidth_targets, "rt"), ("stress", stress_targets, "stress"),
               ("stress_full", stress_full_targets, "stress_full"), ("mesh", mesh_targets, "mesh"),
               ("grasp", grasp_targets, "grasp")]
