@@ -93,7 +93,7 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision, public SoftContact
     out.seconds_response += seconds_between(t0, t1);
     thin_body::hunt_crossley_force(model_, frame_, soft, data_, out);
     if (in_solver()) thin_body::friction_force_on_tool(model_, frame_, soft, data_, out);
-    out.contacted_triangles = static_cast<int>(data_.contacted_faces.size());
+    out.contacted_triangles = static_cast<int>(data_.sweep.contacted_faces.size());
     out.seconds_force = seconds_between(t1, Clock::now());
   }
 
@@ -177,8 +177,8 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision, public SoftContact
     if (!report_.broad_phase_hit) {
       // Out of contact: nothing else runs; the tool nodes' contact memory ends here.
       if (had_contact_) {
-        std::fill(data_.node_face.begin(), data_.node_face.end(), -1);
-        std::fill(data_.node_age.begin(), data_.node_age.end(), 0);
+        std::fill(data_.sweep.node_face.begin(), data_.sweep.node_face.end(), -1);
+        std::fill(data_.sweep.node_age.begin(), data_.sweep.node_age.end(), 0);
         had_contact_ = false;
       }
       return;
@@ -186,8 +186,8 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision, public SoftContact
     had_contact_ = true;
     thin_body::sweep_tool_nodes(model_, data_);
     report_.both_face_contacts = thin_body::exclude_infeasible_pairs(model_, data_);
-    report_.excluded_pairs = static_cast<int>(data_.exclusion.size());
-    report_.colliding_tool_nodes = static_cast<int>(data_.contact_nodes.size()) - report_.excluded_pairs;
+    report_.excluded_pairs = static_cast<int>(data_.exclusion.vector.size());
+    report_.colliding_tool_nodes = static_cast<int>(data_.sweep.contact_nodes.size()) - report_.excluded_pairs;
     const Clock::time_point t2 = Clock::now();
     report_.seconds_narrow = seconds_between(t1, t2);
     const thin_body::DisplacementCounts counts = thin_body::place_contact_nodes(model_, frame_, soft, data_, node_bounds_);

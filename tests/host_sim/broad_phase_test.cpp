@@ -80,7 +80,7 @@ FaceSets needed_faces(const thin_body::CollisionModel& model, const thin_body::C
     bool held = false;
     for (const int v : model.soft.face_nodes[static_cast<std::size_t>(f)]) {
       const Eigen::Vector3d end = frame.r_cur.transpose() * (to_eigen(soft.m_nodes[v].m_x) - frame.t_cur);
-      held = held || (data.hold_stamp[static_cast<std::size_t>(v)] == frame.step - 1 && release.contains(end));
+      held = held || (data.displacement.hold_stamp[static_cast<std::size_t>(v)] == frame.step - 1 && release.contains(end));
       box_tool.extend(frame.r_prev.transpose() * (to_eigen(soft.m_nodes[v].m_q) - frame.t_prev));
       box_tool.extend(end);
       box_world.extend(to_eigen(soft.m_nodes[v].m_q));
@@ -108,10 +108,10 @@ void expect_between(const std::set<int>& got, const FaceSets& sets, const std::s
 // keeps but the pre-filter dropped would be missing here even where brute force does not call it
 // needed.
 void expect_reached_faces_decided_exactly(const thin_body::CollisionData& data, std::int64_t step, const FaceSets& sets, const std::string& where) {
-  const std::set<int> got(data.candidate_faces.begin(), data.candidate_faces.end());
+  const std::set<int> got(data.broad.candidate_faces.begin(), data.broad.candidate_faces.end());
   int wrong = 0, first = -1;
-  for (int f = 0; f < static_cast<int>(data.face_candidate_stamp.size()); ++f) {
-    const bool reached = data.face_candidate_stamp[static_cast<std::size_t>(f)] == step;
+  for (int f = 0; f < static_cast<int>(data.broad.face_candidate_stamp.size()); ++f) {
+    const bool reached = data.broad.face_candidate_stamp[static_cast<std::size_t>(f)] == step;
     const bool expected = reached && sets.allowed.count(f) != 0;
     if (expected != (got.count(f) != 0)) {
       ++wrong;
@@ -170,8 +170,8 @@ struct Harness {
     if (with_bounds) take_bounds();
     const bool hit = thin_body::broad_phase(model, frame, world.soft(), data, with_bounds ? &bounds : nullptr);
     if (!hit) {
-      std::fill(data.node_face.begin(), data.node_face.end(), -1);
-      std::fill(data.node_age.begin(), data.node_age.end(), 0);
+      std::fill(data.sweep.node_face.begin(), data.sweep.node_face.end(), -1);
+      std::fill(data.sweep.node_age.begin(), data.sweep.node_age.end(), 0);
       return frame;
     }
     if (respond) {
@@ -187,27 +187,27 @@ struct Harness {
 
   std::vector<int> last_contact_nodes() const {
     std::vector<int> out;
-    for (const int n : data.contact_nodes)
-      if (data.node_face[static_cast<std::size_t>(n)] >= 0) out.push_back(n);
+    for (const int n : data.sweep.contact_nodes)
+      if (data.sweep.node_face[static_cast<std::size_t>(n)] >= 0) out.push_back(n);
     return out;
   }
 
-  std::set<int> candidate_faces() const { return {data.candidate_faces.begin(), data.candidate_faces.end()}; }
+  std::set<int> candidate_faces() const { return {data.broad.candidate_faces.begin(), data.broad.candidate_faces.end()}; }
 
   void take_bounds() { bounds = bounds_as_the_solver_leaves_them(world.soft()); }
 };
 
 void expect_candidate_nodes_are_the_vertices(Harness& h, const thin_body::StepFrame& frame) {
   std::set<int> vertices;
-  for (const int f : h.data.candidate_faces)
+  for (const int f : h.data.broad.candidate_faces)
     for (const int v : h.model.soft.face_nodes[static_cast<std::size_t>(f)]) vertices.insert(v);
-  const std::set<int> nodes(h.data.candidate_nodes.begin(), h.data.candidate_nodes.end());
-  EXPECT_EQ(nodes.size(), h.data.candidate_nodes.size()) << "a candidate node listed twice";
+  const std::set<int> nodes(h.data.broad.candidate_nodes.begin(), h.data.broad.candidate_nodes.end());
+  EXPECT_EQ(nodes.size(), h.data.broad.candidate_nodes.size()) << "a candidate node listed twice";
   EXPECT_EQ(nodes, vertices);
-  for (const int v : h.data.candidate_nodes) {
+  for (const int v : h.data.broad.candidate_nodes) {
     const auto i = static_cast<std::size_t>(v);
     const Eigen::Vector3d start = frame.r_prev.transpose() * (to_eigen(h.world.soft().m_nodes[v].m_q) - frame.t_prev);
-    EXPECT_LT((h.data.start_tool_m[i] - start).norm(), 1e-9);
+    EXPECT_LT((h.data.broad.start_tool_m[i] - start).norm(), 1e-9);
   }
 }
 
@@ -233,13 +233,13 @@ TEST(BroadPhase, RandomPosesGiveEveryNeededFaceAndNoOther) {
           (Eigen::Quaterniond(Eigen::AngleAxisd(0.2 * unit(rng), Eigen::Vector3d(unit(rng), unit(rng), unit(rng)).normalized())) *
            previous.orientation_world).normalized();
       // Some tool nodes "in contact last step" (the side-memory region of the query).
-      h.data.contact_nodes.clear();
-      std::fill(h.data.node_face.begin(), h.data.node_face.end(), -1);
+      h.data.sweep.contact_nodes.clear();
+      std::fill(h.data.sweep.node_face.begin(), h.data.sweep.node_face.end(), -1);
       if (trial % 2 == 0) {
         const int first = static_cast<int>(std::abs(unit(rng)) * (h.tool.node_count() - 5));
         for (int n = first; n < first + 5; ++n) {
-          h.data.contact_nodes.push_back(n);
-          h.data.node_face[static_cast<std::size_t>(n)] = 0;
+          h.data.sweep.contact_nodes.push_back(n);
+          h.data.sweep.node_face[static_cast<std::size_t>(n)] = 0;
         }
       }
       const std::vector<int> memory = h.last_contact_nodes();
@@ -282,7 +282,7 @@ TEST(BroadPhase, PlungesAndHoldsGiveEveryNeededFaceAndNoOther) {
       expect_between(h.candidate_faces(), expected, where);
       expect_reached_faces_decided_exactly(h.data, frame.step, expected, where);
       if (HasFailure()) return;
-      contact_steps += h.data.contact_nodes.empty() ? 0 : 1;
+      contact_steps += h.data.sweep.contact_nodes.empty() ? 0 : 1;
       previous = current;
     }
     EXPECT_GT(contact_steps, 100) << "speed " << speed;
@@ -304,7 +304,7 @@ TEST(BroadPhase, NodesMovedAfterBulletFittedTheirLeavesAreStillFound) {
     ToolPose far;
     far.position_world_m = Eigen::Vector3d(0, top + 0.2, 0);
     (void)h.step(far, far, true);  // out of contact: no candidates carried to the next step
-    ASSERT_TRUE(h.data.candidate_faces.empty());
+    ASSERT_TRUE(h.data.broad.candidate_faces.empty());
     // Leaves fitted tightly round the nodes (Bullet inserts them 0.25 m loose and only refits a
     // leaf its node has left), so that the staleness below is Bullet's own.
     h.world.step_without_dynamics();
@@ -404,19 +404,19 @@ TEST(BroadPhase, PreFilterKeepsEveryFaceTheExactTestKeeps) {
         n.m_q = btVector3(static_cast<btScalar>(q.x()), static_cast<btScalar>(q.y()), static_cast<btScalar>(q.z()));
         n.m_x = btVector3(static_cast<btScalar>(x.x()), static_cast<btScalar>(x.y()), static_cast<btScalar>(x.z()));
       }
-      h.data.contact_nodes.clear();
-      std::fill(h.data.node_face.begin(), h.data.node_face.end(), -1);
-      if (reason == Reason::kHeldVertexInReleaseBand && with_reason) h.data.hold_stamp[static_cast<std::size_t>(nodes[0])] = h.data.step;
+      h.data.sweep.contact_nodes.clear();
+      std::fill(h.data.sweep.node_face.begin(), h.data.sweep.node_face.end(), -1);
+      if (reason == Reason::kHeldVertexInReleaseBand && with_reason) h.data.displacement.hold_stamp[static_cast<std::size_t>(nodes[0])] = h.data.step;
       if (reason == Reason::kMemoryBand && with_reason) {
         // Bottom-face tool nodes within 3 mm of the face's footprint were in contact last step.
         for (int n = 0; n < plate.node_count(); ++n) {
           const Eigen::Vector3d& p = plate.positions_tool_m()[static_cast<std::size_t>(n)];
           if (p.y() < bottom + 1e-9 && std::abs(p.x()) < 0.003 && std::abs(p.z()) < 0.003) {
-            h.data.contact_nodes.push_back(n);
-            h.data.node_face[static_cast<std::size_t>(n)] = face;
+            h.data.sweep.contact_nodes.push_back(n);
+            h.data.sweep.node_face[static_cast<std::size_t>(n)] = face;
           }
         }
-        ASSERT_FALSE(h.data.contact_nodes.empty());
+        ASSERT_FALSE(h.data.sweep.contact_nodes.empty());
       }
       const std::string where = std::string(reason == Reason::kStretchedAcrossTheRim ? "stretched across the rim"
                                             : reason == Reason::kHeldVertexInReleaseBand ? "held vertex" : "memory band") +
@@ -433,7 +433,7 @@ TEST(BroadPhase, PreFilterKeepsEveryFaceTheExactTestKeeps) {
       const FaceSets expected = needed_faces(h.model, h.data, frame, soft, h.last_contact_nodes());
       ASSERT_EQ(expected.allowed.count(face) != 0, with_reason) << where << ": the exact test must keep the face for its reason only";
       (void)h.step(previous, current, false);
-      EXPECT_EQ(h.data.face_candidate_stamp[static_cast<std::size_t>(face)], frame.step) << where << ": the face must be reached";
+      EXPECT_EQ(h.data.broad.face_candidate_stamp[static_cast<std::size_t>(face)], frame.step) << where << ": the face must be reached";
       EXPECT_EQ(h.candidate_faces().count(face) != 0, with_reason) << where;
       expect_between(h.candidate_faces(), expected, where);
       expect_reached_faces_decided_exactly(h.data, frame.step, expected, where);
@@ -472,11 +472,11 @@ TEST(BroadPhase, NodesMovedByAnotherPartAfterTheBoundsWereTakenAreFound) {
     thin_body::sweep_tool_nodes(model_a, data_a);
     (void)thin_body::exclude_infeasible_pairs(model_a, data_a);
     (void)thin_body::enforce_displacement(model_a, frame_a, world.soft(), data_a, shared);
-    ASSERT_GT(data_a.moved_nodes.size(), 50u);
+    ASSERT_GT(data_a.displacement.moved_nodes.size(), 50u);
     data_b.step = 1;
     const thin_body::StepFrame frame_b = make_frame(model_b, 1, b_pose, b_pose);
     (void)thin_body::broad_phase(model_b, frame_b, world.soft(), data_b, shared);
-    candidates_of_b.emplace_back(data_b.candidate_faces.begin(), data_b.candidate_faces.end());
+    candidates_of_b.emplace_back(data_b.broad.candidate_faces.begin(), data_b.broad.candidate_faces.end());
   }
   EXPECT_FALSE(candidates_of_b[0].empty()) << "A's displaced nodes lie inside B";
   EXPECT_EQ(candidates_of_b[1], candidates_of_b[0]);
@@ -491,16 +491,16 @@ TEST(BroadPhase, OutOfContactNoFaceIsTested) {
   (void)h.step(previous, current, true);
   h.world.step_dynamics();
   (void)h.step(current, current, true);
-  EXPECT_TRUE(h.data.candidate_faces.empty());
-  EXPECT_EQ(h.data.broad_nodes_scanned, h.model.soft.node_count);
-  EXPECT_EQ(h.data.broad_seed_nodes, 0);
-  EXPECT_EQ(h.data.broad_faces_tested, 0);
+  EXPECT_TRUE(h.data.broad.candidate_faces.empty());
+  EXPECT_EQ(h.data.broad.nodes_scanned, h.model.soft.node_count);
+  EXPECT_EQ(h.data.broad.seed_nodes, 0);
+  EXPECT_EQ(h.data.broad.faces_tested, 0);
   // With the solver's node bounds the whole body is tested once and no node is read.
   h.with_bounds = true;
   (void)h.step(current, current, true);
-  EXPECT_TRUE(h.data.candidate_faces.empty());
-  EXPECT_EQ(h.data.broad_nodes_scanned, 0);
-  EXPECT_EQ(h.data.broad_seed_nodes, 0);
+  EXPECT_TRUE(h.data.broad.candidate_faces.empty());
+  EXPECT_EQ(h.data.broad.nodes_scanned, 0);
+  EXPECT_EQ(h.data.broad.seed_nodes, 0);
 }
 
 // The work for a fixed contact: a plate held on the sphere's top at the depth where about 24
@@ -522,14 +522,14 @@ TEST(BroadPhase, WorkForAFixedContactDoesNotGrowWithTheMesh) {
       ToolPose pose;
       pose.position_world_m = Eigen::Vector3d(0, top + 0.001 - depth, 0);
       (void)h.step(pose, pose, false);
-      if (h.data.candidate_faces.size() >= 24) break;
+      if (h.data.broad.candidate_faces.size() >= 24) break;
     }
     ToolPose pose;
     pose.position_world_m = Eigen::Vector3d(0, top + 0.001 - depth, 0);
-    h.data.broad_previous_candidates.clear();  // measure one step's own work, not the re-test of the last
+    h.data.broad.previous_candidates.clear();  // measure one step's own work, not the re-test of the last
     (void)h.step(pose, pose, false);
-    rows.push_back({faces, static_cast<int>(h.data.candidate_faces.size()), h.data.broad_nodes_scanned, h.data.broad_seed_nodes,
-                    h.data.broad_faces_tested, h.data.broad_faces_transformed});
+    rows.push_back({faces, static_cast<int>(h.data.broad.candidate_faces.size()), h.data.broad.nodes_scanned, h.data.broad.seed_nodes,
+                    h.data.broad.faces_tested, h.data.broad.faces_transformed});
     std::printf("faces %6d: candidate faces %4d, nodes scanned %5d, seed nodes %5d, faces tested %5d, transformed %4d\n", faces,
                 rows.back().candidates, rows.back().scanned, rows.back().seeds, rows.back().tested, rows.back().transformed);
     EXPECT_EQ(rows.back().scanned, h.model.soft.node_count);

@@ -76,10 +76,10 @@ BruteForce brute_force(const thin_body::CollisionModel& model, const thin_body::
   BruteForce out{std::vector<int>(count, -1), std::vector<double>(count, 0.0), std::vector<double>(count, 0.0), std::vector<char>(count, 0)};
   const double contact = model.params.contact_distance_m;
   const double sign = model.soft.outward_sign;
-  for (const int face : data.candidate_faces) {
+  for (const int face : data.broad.candidate_faces) {
     const auto& v = model.soft.face_nodes[static_cast<std::size_t>(face)];
-    const auto s = [&](int k) { return data.start_tool_m[static_cast<std::size_t>(v[static_cast<std::size_t>(k)])]; };
-    const auto e = [&](int k) { return data.end_tool_m[static_cast<std::size_t>(v[static_cast<std::size_t>(k)])]; };
+    const auto s = [&](int k) { return data.broad.start_tool_m[static_cast<std::size_t>(v[static_cast<std::size_t>(k)])]; };
+    const auto e = [&](int k) { return data.broad.end_tool_m[static_cast<std::size_t>(v[static_cast<std::size_t>(k)])]; };
     const Tri start = tri(s(0), s(1), s(2), sign);
     const Tri end = tri(e(0), e(1), e(2), sign);
     if (!start.valid || !end.valid) continue;
@@ -178,28 +178,28 @@ Seen compare_with_brute_force(const ToolNodes& tool, int trials, unsigned seed, 
     const Eigen::Matrix3d rotation_start = turn;
     const Eigen::Matrix3d rotation_end = trial % 2 == 0 ? turn : Eigen::Matrix3d(turn * Eigen::AngleAxisd(0.2 * unit(rng), Eigen::Vector3d::UnitX()));
     const double jitter = trial % 4 == 0 ? 0.0 : 1e-3 * unit(rng);
-    place_sphere(soft, centre_start, rotation_start, jitter, rng, data.start_tool_m);
-    place_sphere(soft, centre_end, rotation_end, jitter, rng, data.end_tool_m);
-    data.candidate_faces.clear();
-    for (int f = 0; f < model.soft.face_count; ++f) data.candidate_faces.push_back(f);
+    place_sphere(soft, centre_start, rotation_start, jitter, rng, data.broad.start_tool_m);
+    place_sphere(soft, centre_end, rotation_end, jitter, rng, data.broad.end_tool_m);
+    data.broad.candidate_faces.clear();
+    for (int f = 0; f < model.soft.face_count; ++f) data.broad.candidate_faces.push_back(f);
     // Side memory: last step's contacts (what the sweep keeps from the step before) on ~20 % of
     // the nodes on one face, so the memory-depth path and the per-plane "had contact" are used.
-    data.contact_nodes.clear();
-    std::fill(data.node_face.begin(), data.node_face.end(), -1);
+    data.sweep.contact_nodes.clear();
+    std::fill(data.sweep.node_face.begin(), data.sweep.node_face.end(), -1);
     for (int n = 0; n < tool.node_count(); ++n) {
       if (unit(rng) < 0.2 && tool.normals_tool()[static_cast<std::size_t>(n)][w] > 0.5) {
-        data.node_face[static_cast<std::size_t>(n)] = 0;
-        data.contact_nodes.push_back(n);
+        data.sweep.node_face[static_cast<std::size_t>(n)] = 0;
+        data.sweep.contact_nodes.push_back(n);
       }
     }
-    const std::vector<int> face_prev = data.node_face;
-    std::fill(data.node_age.begin(), data.node_age.end(), 1);  // so that the expected ages are 2 (held on) or 1 (new)
+    const std::vector<int> face_prev = data.sweep.node_face;
+    std::fill(data.sweep.node_age.begin(), data.sweep.node_age.end(), 1);  // so that the expected ages are 2 (held on) or 1 (new)
     const BruteForce expected = brute_force(model, data, face_prev);
     thin_body::sweep_tool_nodes(model, data);
-    node_tests_by_kind[static_cast<std::size_t>(kind)] += data.sweep_node_tests;
+    node_tests_by_kind[static_cast<std::size_t>(kind)] += data.sweep.node_tests;
     ++trials_by_kind[static_cast<std::size_t>(kind)];
     if (jitter == 0.0) {
-      rigid_node_tests_by_kind[static_cast<std::size_t>(kind)] += data.sweep_node_tests;
+      rigid_node_tests_by_kind[static_cast<std::size_t>(kind)] += data.sweep.node_tests;
       ++rigid_trials_by_kind[static_cast<std::size_t>(kind)];
     }
     int contacts = 0;
@@ -207,10 +207,10 @@ Seen compare_with_brute_force(const ToolNodes& tool, int trials, unsigned seed, 
     for (std::size_t n = 0; n < expected.face.size(); ++n) {
       contacts += expected.face[n] >= 0 ? 1 : 0;
       seen.beyond_swept_bounds += expected.face[n] >= 0 && expected.beyond_swept_bounds[n] != 0 ? 1 : 0;
-      const bool same = data.node_face[n] == expected.face[n] &&
-                        (expected.face[n] < 0 || (data.node_tau[n] == expected.tau[n] && data.node_facing[n] == expected.facing[n]));
+      const bool same = data.sweep.node_face[n] == expected.face[n] &&
+                        (expected.face[n] < 0 || (data.sweep.node_tau[n] == expected.tau[n] && data.sweep.node_facing[n] == expected.facing[n]));
       if (!same && mismatches++ < 3)
-        ADD_FAILURE() << label << " trial " << trial << " tool node " << n << ": sweep face " << data.node_face[n] << " tau " << data.node_tau[n]
+        ADD_FAILURE() << label << " trial " << trial << " tool node " << n << ": sweep face " << data.sweep.node_face[n] << " tau " << data.sweep.node_tau[n]
                       << ", brute force face " << expected.face[n] << " tau " << expected.tau[n];
     }
     EXPECT_EQ(mismatches, 0) << label << " trial " << trial;
@@ -218,9 +218,9 @@ Seen compare_with_brute_force(const ToolNodes& tool, int trials, unsigned seed, 
     std::vector<int> listed;
     for (std::size_t n = 0; n < expected.face.size(); ++n)
       if (expected.face[n] >= 0) listed.push_back(static_cast<int>(n));
-    EXPECT_EQ(data.contact_nodes, listed) << label << " trial " << trial;
+    EXPECT_EQ(data.sweep.contact_nodes, listed) << label << " trial " << trial;
     for (const int n : listed)
-      EXPECT_EQ(data.node_age[static_cast<std::size_t>(n)], face_prev[static_cast<std::size_t>(n)] >= 0 ? 2 : 1) << label << " node " << n;
+      EXPECT_EQ(data.sweep.node_age[static_cast<std::size_t>(n)], face_prev[static_cast<std::size_t>(n)] >= 0 ? 2 : 1) << label << " node " << n;
     seen.contacts += contacts;
   }
   const auto per_step = [](const std::array<long, 3>& tests, const std::array<int, 3>& steps, std::size_t kind) {

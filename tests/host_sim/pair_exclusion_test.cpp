@@ -22,12 +22,12 @@ class PairExclusion : public ::testing::Test {
   // Puts node in contact with soft face `face` as the sweep would have.
   static void touch(CollisionData& data, int node, int face, int age, double facing, double tau) {
     const auto n = static_cast<std::size_t>(node);
-    data.node_face[n] = face;
-    data.node_age[n] = age;
-    data.node_facing[n] = facing;
-    data.node_tau[n] = tau;
-    data.contact_nodes.push_back(node);
-    std::sort(data.contact_nodes.begin(), data.contact_nodes.end());
+    data.sweep.node_face[n] = face;
+    data.sweep.node_age[n] = age;
+    data.sweep.node_facing[n] = facing;
+    data.sweep.node_tau[n] = tau;
+    data.sweep.contact_nodes.push_back(node);
+    std::sort(data.sweep.contact_nodes.begin(), data.sweep.contact_nodes.end());
   }
 
   test_scene::SoftWorld world_{false};
@@ -45,13 +45,13 @@ TEST_F(PairExclusion, MutualPairKeepsTheFaceThatMeetsTheSurfaceHeadOn) {
   touch(data, bottom, 3, 1, -1.0, 0.2);  // head on
   touch(data, top, 3, 1, +1.0, 0.6);     // the triangle is behind it
   EXPECT_EQ(exclude_infeasible_pairs(model, data), 0);
-  ASSERT_EQ(data.exclusion.size(), 1u);
-  EXPECT_EQ(data.exclusion[0], top);
-  EXPECT_EQ(data.node_face[static_cast<std::size_t>(top)], -1) << "excluded: no contact this step";
-  EXPECT_EQ(data.node_age[static_cast<std::size_t>(top)], 0) << "and no side memory for the next";
-  ASSERT_EQ(data.contacted_faces.size(), 1u);
-  EXPECT_EQ(data.face_plane[3], tool.plane_of_node()[bottom]);
-  EXPECT_EQ(data.face_lead_node[3], bottom);
+  ASSERT_EQ(data.exclusion.vector.size(), 1u);
+  EXPECT_EQ(data.exclusion.vector[0], top);
+  EXPECT_EQ(data.sweep.node_face[static_cast<std::size_t>(top)], -1) << "excluded: no contact this step";
+  EXPECT_EQ(data.sweep.node_age[static_cast<std::size_t>(top)], 0) << "and no side memory for the next";
+  ASSERT_EQ(data.sweep.contacted_faces.size(), 1u);
+  EXPECT_EQ(data.sweep.face_plane[3], tool.plane_of_node()[bottom]);
+  EXPECT_EQ(data.sweep.face_lead_node[3], bottom);
 }
 
 TEST_F(PairExclusion, SideMemoryWinsTheNodeThatWasInContactFirstLed) {
@@ -64,8 +64,8 @@ TEST_F(PairExclusion, SideMemoryWinsTheNodeThatWasInContactFirstLed) {
   touch(data, bottom, 5, 1, -1.0, 0.0);  // just arrived, head on
   touch(data, top, 7, 12, -0.2, 1.0);    // in contact for 12 steps already
   exclude_infeasible_pairs(model, data);
-  ASSERT_EQ(data.exclusion.size(), 1u);
-  EXPECT_EQ(data.exclusion[0], bottom);
+  ASSERT_EQ(data.exclusion.vector.size(), 1u);
+  EXPECT_EQ(data.exclusion.vector[0], bottom);
 }
 
 TEST_F(PairExclusion, OneWayPairIsCrossCheckedFromTheNodeItPointsAt) {
@@ -87,11 +87,11 @@ TEST_F(PairExclusion, OneWayPairIsCrossCheckedFromTheNodeItPointsAt) {
   // "nodes that paired with j" can catch j.
   touch(data, i, 2, 1, -0.9, 0.1);
   touch(data, j, 2, 1, 0.8, 0.3);
-  ASSERT_TRUE(k < 0 || data.node_face[static_cast<std::size_t>(k)] < 0);
+  ASSERT_TRUE(k < 0 || data.sweep.node_face[static_cast<std::size_t>(k)] < 0);
   EXPECT_EQ(exclude_infeasible_pairs(model, data), 0);
-  ASSERT_EQ(data.exclusion.size(), 1u);
-  EXPECT_EQ(data.exclusion[0], j);
-  EXPECT_EQ(data.face_lead_node[2], i);
+  ASSERT_EQ(data.exclusion.vector.size(), 1u);
+  EXPECT_EQ(data.exclusion.vector[0], j);
+  EXPECT_EQ(data.sweep.face_lead_node[2], i);
 
   // The other way round (j leads) the exclusion falls on i, found from i's own pair.
   CollisionData reversed;
@@ -99,8 +99,8 @@ TEST_F(PairExclusion, OneWayPairIsCrossCheckedFromTheNodeItPointsAt) {
   touch(reversed, i, 2, 1, 0.8, 0.3);
   touch(reversed, j, 2, 1, -0.9, 0.1);
   exclude_infeasible_pairs(model, reversed);
-  ASSERT_EQ(reversed.exclusion.size(), 1u);
-  EXPECT_EQ(reversed.exclusion[0], i);
+  ASSERT_EQ(reversed.exclusion.vector.size(), 1u);
+  EXPECT_EQ(reversed.exclusion.vector[0], i);
 }
 
 TEST_F(PairExclusion, RayOnlyKeepsBothFacesAndCountsThem) {
@@ -112,7 +112,7 @@ TEST_F(PairExclusion, RayOnlyKeepsBothFacesAndCountsThem) {
   touch(data, bottom, 3, 1, -1.0, 0.2);
   touch(data, tool.pair_of()[bottom], 3, 1, 1.0, 0.6);
   EXPECT_EQ(exclude_infeasible_pairs(model, data), 1) << "one pair with both faces pushing";
-  EXPECT_TRUE(data.exclusion.empty());
+  EXPECT_TRUE(data.exclusion.vector.empty());
 }
 
 TEST_F(PairExclusion, UnpairedToolExcludesNothing) {
@@ -124,8 +124,8 @@ TEST_F(PairExclusion, UnpairedToolExcludesNothing) {
   touch(data, 0, 1, 1, 1.0, 0.5);
   touch(data, 1, 1, 1, -1.0, 0.5);
   exclude_infeasible_pairs(model, data);
-  EXPECT_TRUE(data.exclusion.empty());
-  EXPECT_EQ(data.contacted_faces.size(), 1u);
+  EXPECT_TRUE(data.exclusion.vector.empty());
+  EXPECT_EQ(data.sweep.contacted_faces.size(), 1u);
 }
 
 }  // namespace

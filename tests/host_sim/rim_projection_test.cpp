@@ -46,8 +46,8 @@ struct RimFixture {
     pose.position_world_m = Eigen::Vector3d(kBladeX_m, 0.0, 0.0) + slab_normal_world * (0.02 - kEdgeDepth_m);
     data.step = 1;
     frame = make_step_frame(model, data.step, pose, pose, 1e-3);
-    for (int face = 0; face < model.soft.face_count; ++face) data.candidate_faces.push_back(face);
-    for (int node = 0; node < model.soft.node_count; ++node) data.candidate_nodes.push_back(node);
+    for (int face = 0; face < model.soft.face_count; ++face) data.broad.candidate_faces.push_back(face);
+    for (int node = 0; node < model.soft.node_count; ++node) data.broad.candidate_nodes.push_back(node);
   }
 
   [[nodiscard]] Eigen::Vector3d node_tool(int i) {
@@ -126,8 +126,8 @@ TEST(RimProjection, ACornerHeldOnAToolFaceIsNotMoved) {
   std::vector<int> held;
   for (int i = 0; i < fx.model.soft.node_count; ++i) {
     if (fx.world.soft().m_nodes[i].m_x.x() > kBladeX_m) {
-      fx.data.hold_stamp[static_cast<std::size_t>(i)] = fx.data.step;
-      fx.data.hold_plane[static_cast<std::size_t>(i)] = 0;
+      fx.data.displacement.hold_stamp[static_cast<std::size_t>(i)] = fx.data.step;
+      fx.data.displacement.hold_plane[static_cast<std::size_t>(i)] = 0;
       held.push_back(i);
     }
   }

@@ -51,15 +51,15 @@ struct FrictionFixture {
     // The plate's lower face (outward normal −y in the tool frame = world).
     for (std::size_t q = 0; q < tool.planes().size(); ++q)
       if (tool.planes()[q].normal_tool.y() < -0.5) plane = static_cast<int>(q);
-    data.candidate_nodes.push_back(node);
+    data.broad.candidate_nodes.push_back(node);
     // Held on that face (+ skin), sticking where it is.
     const ToolPlane& face = tool.planes()[static_cast<std::size_t>(plane)];
     const Eigen::Vector3d on_face_tool = Eigen::Vector3d(0.0, 0.0, 0.0) + (face.offset_m + model.params.skin_m) * face.normal_tool;
     set_node_tool(on_face_tool);
-    data.hold_stamp[static_cast<std::size_t>(node)] = data.step;
-    data.hold_plane[static_cast<std::size_t>(node)] = plane;
-    data.friction_anchor_tool_m[static_cast<std::size_t>(node)] = on_face_tool;
-    data.friction_anchor_stamp[static_cast<std::size_t>(node)] = data.step - 1;
+    data.displacement.hold_stamp[static_cast<std::size_t>(node)] = data.step;
+    data.displacement.hold_plane[static_cast<std::size_t>(node)] = plane;
+    data.solver.friction_anchor_tool_m[static_cast<std::size_t>(node)] = on_face_tool;
+    data.solver.friction_anchor_stamp[static_cast<std::size_t>(node)] = data.step - 1;
     start_iterates(model, frame, world.soft(), data);
   }
 

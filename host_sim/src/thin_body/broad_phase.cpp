@@ -187,8 +187,8 @@ Query make_query(const CollisionModel& model, const StepFrame& frame, const Coll
   const auto& positions = model.tool.positions_tool_m();
   q.near_tool = grown(model.tool.bounds_tool_m(), near_pad);
   q.release_tool = grown(model.tool.bounds_tool_m(), release_pad_m(model));
-  for (const int node : data.contact_nodes)
-    if (data.node_face[static_cast<std::size_t>(node)] >= 0) q.memory_tool.extend(positions[static_cast<std::size_t>(node)]);
+  for (const int node : data.sweep.contact_nodes)
+    if (data.sweep.node_face[static_cast<std::size_t>(node)] >= 0) q.memory_tool.extend(positions[static_cast<std::size_t>(node)]);
   if (!q.memory_tool.isEmpty()) q.memory_tool = grown(q.memory_tool, memory_pad);
   // The padded tool-frame boxes are transformed corner by corner, so their world bounds hold the
   // pads whatever the orientation.
@@ -297,7 +297,7 @@ class Collector {
 
   // The exact test of every face the pre-filter kept, in the order they were reached.
   void test_kept_faces() {
-    for (const int face : data_.broad_faces_kept) test_face(face);
+    for (const int face : data_.broad.faces_kept) test_face(face);
   }
 
  private:
@@ -307,9 +307,9 @@ class Collector {
   // Bullet's node positions: no transform, no stamp.
   void prefilter_face(int face) {
     const auto f = static_cast<std::size_t>(face);
-    if (data_.face_candidate_stamp[f] == frame_.step) return;
-    data_.face_candidate_stamp[f] = frame_.step;
-    ++data_.broad_faces_tested;
+    if (data_.broad.face_candidate_stamp[f] == frame_.step) return;
+    data_.broad.face_candidate_stamp[f] = frame_.step;
+    ++data_.broad.faces_tested;
     const std::array<int, 3>& v = model_.soft.face_nodes[f];
     const btSoftBody::Node& a = soft_.m_nodes[v[0]];
     const btSoftBody::Node& b = soft_.m_nodes[v[1]];
@@ -325,29 +325,29 @@ class Collector {
     // needs end_tool to meet it; the hold stamps are read only then.
     if (near_.meets(box_tool.lo, box_tool.hi) || memory_.meets(box_tool.lo, box_tool.hi) ||
         (release_.meets(end_tool.lo, end_tool.hi) && has_vertex_held_last_step(f)))
-      data_.broad_faces_kept.push_back(face);
+      data_.broad.faces_kept.push_back(face);
   }
 
   bool has_vertex_held_last_step(std::size_t face) const {
     for (const int vertex : model_.soft.face_nodes[face])
-      if (data_.hold_stamp[static_cast<std::size_t>(vertex)] == frame_.step - 1) return true;
+      if (data_.displacement.hold_stamp[static_cast<std::size_t>(vertex)] == frame_.step - 1) return true;
     return false;
   }
 
   void transform(int node) {
     const auto i = static_cast<std::size_t>(node);
-    if (data_.soft_stamp[i] == frame_.step) return;
-    data_.soft_stamp[i] = frame_.step;
+    if (data_.broad.soft_stamp[i] == frame_.step) return;
+    data_.broad.soft_stamp[i] = frame_.step;
     const btSoftBody::Node& n = soft_.m_nodes[node];
-    data_.start_tool_m[i] = frame_.r_prev.transpose() * (to_eigen(n.m_q) - frame_.t_prev);
-    data_.end_tool_m[i] = frame_.r_cur.transpose() * (to_eigen(n.m_x) - frame_.t_cur);
+    data_.broad.start_tool_m[i] = frame_.r_prev.transpose() * (to_eigen(n.m_q) - frame_.t_prev);
+    data_.broad.end_tool_m[i] = frame_.r_cur.transpose() * (to_eigen(n.m_x) - frame_.t_cur);
   }
 
   // A vertex held on a tool face last step and still within the release pad of the tool.
   bool has_held_vertex_in_reach(std::size_t face) const {
     for (const int vertex : model_.soft.face_nodes[face]) {
       const auto v = static_cast<std::size_t>(vertex);
-      if (data_.hold_stamp[v] == frame_.step - 1 && query_.release_tool.contains(data_.end_tool_m[v])) return true;
+      if (data_.displacement.hold_stamp[v] == frame_.step - 1 && query_.release_tool.contains(data_.broad.end_tool_m[v])) return true;
     }
     return false;
   }
@@ -355,20 +355,20 @@ class Collector {
   // The exact test: the face's tool-frame start/end bounds against the queries.
   void test_face(int face) {
     const auto f = static_cast<std::size_t>(face);
-    ++data_.broad_faces_transformed;
+    ++data_.broad.faces_transformed;
     Eigen::AlignedBox3d box_tool;
     for (const int vertex : model_.soft.face_nodes[f]) {
       transform(vertex);
-      box_tool.extend(data_.start_tool_m[static_cast<std::size_t>(vertex)]);
-      box_tool.extend(data_.end_tool_m[static_cast<std::size_t>(vertex)]);
+      box_tool.extend(data_.broad.start_tool_m[static_cast<std::size_t>(vertex)]);
+      box_tool.extend(data_.broad.end_tool_m[static_cast<std::size_t>(vertex)]);
     }
     if (!query_.face_needed(box_tool) && !has_held_vertex_in_reach(f)) return;
-    data_.candidate_faces.push_back(face);
+    data_.broad.candidate_faces.push_back(face);
     for (const int vertex : model_.soft.face_nodes[f]) {
       const auto v = static_cast<std::size_t>(vertex);
-      if (data_.broad_listed_stamp[v] == frame_.step) continue;
-      data_.broad_listed_stamp[v] = frame_.step;
-      data_.candidate_nodes.push_back(vertex);
+      if (data_.broad.listed_stamp[v] == frame_.step) continue;
+      data_.broad.listed_stamp[v] = frame_.step;
+      data_.broad.candidate_nodes.push_back(vertex);
     }
   }
 
@@ -404,7 +404,7 @@ void prefetch_faces_around(const CollisionModel& model, const btSoftBody& soft, 
     for (int k = surface.faces_of_node_begin[n]; k < surface.faces_of_node_begin[n + 1]; ++k) {
       const auto f = static_cast<std::size_t>(surface.faces_of_node[static_cast<std::size_t>(k)]);
       prefetch(&surface.face_nodes[f]);
-      prefetch(&data.face_candidate_stamp[f]);
+      prefetch(&data.broad.face_candidate_stamp[f]);
     }
   }
   for (const int node : nodes) {
@@ -422,26 +422,26 @@ void prefetch_faces_around(const CollisionModel& model, const btSoftBody& soft, 
 
 // What the exact test reads and writes for the vertices of the faces the pre-filter kept.
 void prefetch_kept_faces(const CollisionModel& model, const CollisionData& data) {
-  for (const int face : data.broad_faces_kept) {
+  for (const int face : data.broad.faces_kept) {
     for (const int vertex : model.soft.face_nodes[static_cast<std::size_t>(face)]) {
       const auto v = static_cast<std::size_t>(vertex);
-      prefetch(&data.soft_stamp[v]);
-      prefetch(&data.start_tool_m[v]);
-      prefetch(&data.end_tool_m[v]);
-      prefetch(&data.hold_stamp[v]);
-      prefetch(&data.broad_listed_stamp[v]);
+      prefetch(&data.broad.soft_stamp[v]);
+      prefetch(&data.broad.start_tool_m[v]);
+      prefetch(&data.broad.end_tool_m[v]);
+      prefetch(&data.displacement.hold_stamp[v]);
+      prefetch(&data.broad.listed_stamp[v]);
     }
   }
 }
 
 // What a broad phase that found nothing leaves: no candidates, no work counted.
 void clear_step_results(CollisionData& data) {
-  data.candidate_nodes.clear();
-  data.candidate_faces.clear();
-  data.broad_nodes_scanned = 0;
-  data.broad_seed_nodes = 0;
-  data.broad_faces_tested = 0;
-  data.broad_faces_transformed = 0;
+  data.broad.candidate_nodes.clear();
+  data.broad.candidate_faces.clear();
+  data.broad.nodes_scanned = 0;
+  data.broad.seed_nodes = 0;
+  data.broad.faces_tested = 0;
+  data.broad.faces_transformed = 0;
 }
 
 }  // namespace
@@ -471,18 +471,18 @@ bool broad_phase_out_of_reach(const CollisionModel& model, const ToolPose& previ
 
 bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data,
                  const SoftNodeBounds* node_bounds) {
-  if (data.broad_listed_stamp.size() != static_cast<std::size_t>(model.soft.node_count)) {
+  if (data.broad.listed_stamp.size() != static_cast<std::size_t>(model.soft.node_count)) {
     // First call: size the broad phase's own buffers (the step allocates nothing afterwards).
-    data.broad_listed_stamp.assign(static_cast<std::size_t>(model.soft.node_count), -1);
-    data.broad_previous_candidates.clear();
-    data.broad_previous_candidates.reserve(static_cast<std::size_t>(model.soft.node_count));
-    data.candidate_nodes.reserve(static_cast<std::size_t>(model.soft.node_count));
-    data.broad_scan_hits.reserve(static_cast<std::size_t>(model.soft.node_count));
-    data.broad_faces_kept.reserve(static_cast<std::size_t>(model.soft.face_count));
+    data.broad.listed_stamp.assign(static_cast<std::size_t>(model.soft.node_count), -1);
+    data.broad.previous_candidates.clear();
+    data.broad.previous_candidates.reserve(static_cast<std::size_t>(model.soft.node_count));
+    data.broad.candidate_nodes.reserve(static_cast<std::size_t>(model.soft.node_count));
+    data.broad.scan_hits.reserve(static_cast<std::size_t>(model.soft.node_count));
+    data.broad.faces_kept.reserve(static_cast<std::size_t>(model.soft.face_count));
   }
-  data.candidate_nodes.swap(data.broad_previous_candidates);
+  data.broad.candidate_nodes.swap(data.broad.previous_candidates);
   clear_step_results(data);
-  data.broad_faces_kept.clear();
+  data.broad.faces_kept.clear();
 
   const Query query = make_query(model, frame, data);
   const bool bounds_usable = node_bounds != nullptr && node_bounds->valid && node_bounds->node_count == model.soft.node_count;
@@ -490,8 +490,8 @@ bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSo
   // face can be needed (Query::faces_world), and nothing else is touched. That matters: after
   // Bullet's step this stage's code and data are cold, and its remaining setup and empty loops
   // cost ~3 µs of cache misses doing nothing (measured on bench collision's 20 480-face sphere).
-  if (bounds_usable && data.broad_previous_candidates.empty() && !body_meets(*node_bounds, query.faces_world)) {
-    data.broad_scan_hits.clear();
+  if (bounds_usable && data.broad.previous_candidates.empty() && !body_meets(*node_bounds, query.faces_world)) {
+    data.broad.scan_hits.clear();
     return false;
   }
   Collector collect(model, frame, soft, query, data);
@@ -502,7 +502,7 @@ bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSo
   const float lo_x = float_below(any.min().x()), lo_y = float_below(any.min().y()), lo_z = float_below(any.min().z());
   const float hi_x = float_above(any.max().x()), hi_y = float_above(any.max().y()), hi_z = float_above(any.max().z());
   const int count = model.soft.node_count;
-  data.broad_scan_hits.clear();
+  data.broad.scan_hits.clear();
   int scanned = 0;
   // Nodes [first, last): the union box test on each, in memory order.
   const auto scan = [&](int first, int last) {
@@ -520,7 +520,7 @@ bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSo
       // Six independent compares and one branch (taken only near the tool).
       const bool near = (std::min(x.x(), q.x()) <= hi_x) & (std::max(x.x(), q.x()) >= lo_x) & (std::min(x.y(), q.y()) <= hi_y) &
                         (std::max(x.y(), q.y()) >= lo_y) & (std::min(x.z(), q.z()) <= hi_z) & (std::max(x.z(), q.z()) >= lo_z);
-      if (near) data.broad_scan_hits.push_back(i);
+      if (near) data.broad.scan_hits.push_back(i);
     }
     scanned += last - first;
   };
@@ -540,21 +540,21 @@ bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSo
   } else {
     scan(0, count);
   }
-  data.broad_nodes_scanned = scanned;
+  data.broad.nodes_scanned = scanned;
   // Everything the faces around these nodes read is cold after Bullet's step (a few thousand
   // misses on the finest mesh, ~60 µs when taken one after another): it is prefetched in stages,
   // each stage's misses in flight together, before the faces are reached in the usual order.
   // Only the seeds' faces: the scan's union box also takes in nodes between the near and the
   // memory query.
   std::size_t seeds = 0;
-  for (const int node : data.broad_scan_hits)
-    if (collect.is_seed(node)) data.broad_scan_hits[seeds++] = node;
-  data.broad_scan_hits.resize(seeds);
-  data.broad_seed_nodes = static_cast<int>(seeds);
-  prefetch_faces_around(model, soft, data, data.broad_previous_candidates);
-  prefetch_faces_around(model, soft, data, data.broad_scan_hits);
-  for (const int node : data.broad_previous_candidates) collect.reach_faces_around(node);
-  for (const int node : data.broad_scan_hits) collect.reach_faces_around(node);
+  for (const int node : data.broad.scan_hits)
+    if (collect.is_seed(node)) data.broad.scan_hits[seeds++] = node;
+  data.broad.scan_hits.resize(seeds);
+  data.broad.seed_nodes = static_cast<int>(seeds);
+  prefetch_faces_around(model, soft, data, data.broad.previous_candidates);
+  prefetch_faces_around(model, soft, data, data.broad.scan_hits);
+  for (const int node : data.broad.previous_candidates) collect.reach_faces_around(node);
+  for (const int node : data.broad.scan_hits) collect.reach_faces_around(node);
   // The exact test, in the order the faces were reached.
   prefetch_kept_faces(model, data);
   collect.test_kept_faces();
@@ -562,13 +562,13 @@ bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSo
   // several triangles it touches at the same moment (a held node: τ = 1 on each), so the
   // traversal order would otherwise decide contacts (clamp scenes: ±25 % peak force between two
   // orders). Face index order does not depend on how the faces were reached.
-  std::sort(data.candidate_faces.begin(), data.candidate_faces.end());
+  std::sort(data.broad.candidate_faces.begin(), data.broad.candidate_faces.end());
   // And the candidate nodes in index order: the response visits them in this order and the
   // first moved node round a face gives it its force plane, so the order the faces were reached
   // in (which depends on the seeds) would otherwise reach the force — and, through a haptic
   // loop, the trajectory.
-  std::sort(data.candidate_nodes.begin(), data.candidate_nodes.end());
-  return !data.candidate_faces.empty();
+  std::sort(data.broad.candidate_nodes.begin(), data.broad.candidate_nodes.end());
+  return !data.broad.candidate_faces.empty();
 }
 
 }  // namespace fissure::host::thin_body

@@ -118,55 +118,84 @@ struct StepFrame {
   Eigen::AlignedBox3d swept_tool_world_m;
 };
 
-struct CollisionData {
-  std::int64_t step = 0;
-  // Tool nodes: contact this step and the side memory from the previous one.
-  std::vector<int> node_face;        // soft face in contact (-1: none)
-  std::vector<int> node_face_prev;
-  std::vector<int> node_age;         // consecutive steps in contact (who led first)
-  std::vector<double> node_tau;      // fraction of the step at which the contact began
-  std::vector<double> node_facing;   // tool normal · soft normal (−1: head on)
-  std::vector<std::int64_t> node_excluded_stamp;
-  std::vector<int> contact_nodes;    // nodes in contact this step (before exclusion)
-  std::vector<int> exclusion;        // the paper's exclusion vector (this step)
-  // Soft nodes near the tool: positions in the tool frame at the start (previous pose, m_q) and
-  // at the end (current pose, m_x) of the step.
+// The mutable state of one collision instance, one sub-struct per pipeline stage (the stage that
+// writes it; later stages read it). "Carried" fields keep their meaning from one step to the next
+// (side memories, filters, anchors: each valid at its stamp); the rest is the stage's scratch for
+// the current step, and the counters say what the last call visited (tests and the bench read
+// them instead of timing). Every vector is sized by allocate_collision_data: no step allocates.
+struct BroadPhaseData {  // stage 1 (broad_phase.cpp)
+  // Output, this step: the soft nodes and faces near the swept tool, and the nodes' positions in
+  // the tool frame at the start (previous pose, m_q) and at the end (current pose, m_x).
+  std::vector<int> candidate_nodes;
+  std::vector<int> candidate_faces;
+  std::vector<std::int64_t> face_candidate_stamp;
   std::vector<std::int64_t> soft_stamp;
   std::vector<Eigen::Vector3d> start_tool_m;
   std::vector<Eigen::Vector3d> end_tool_m;
+  // Scratch (sized on the broad phase's first call).
+  std::vector<std::int64_t> listed_stamp;      // soft node listed in candidate_nodes at this step
+  std::vector<int> previous_candidates;        // carried: last step's candidate nodes (re-tested directly)
+  std::vector<int> scan_hits;                  // nodes inside the scan's union box this step
+  std::vector<int> faces_kept;                 // faces the world-bounds pre-filter passed to the exact test
+  // Counters of the last call.
+  int nodes_scanned = 0;        // soft nodes whose start/end positions the scan read (every node)
+  int seed_nodes = 0;           // soft nodes whose own start/end box met the query
+  int faces_tested = 0;         // soft faces reached and tested (pre-filter on their world bounds)
+  int faces_transformed = 0;    // of those, faces the exact tool-frame test ran on (vertices transformed)
+};
+
+struct NodeSweepData {  // stage 2 (node_sweep.cpp): tool nodes against soft triangles over the step
+  // Per tool node: the soft face in contact (-1: none) this step and, carried, the last one.
+  std::vector<int> node_face;
+  std::vector<int> node_face_prev;
+  std::vector<int> node_age;         // carried: consecutive steps in contact (who led first)
+  std::vector<double> node_tau;      // fraction of the step at which the contact began
+  std::vector<double> node_facing;   // tool normal · soft normal (−1: head on)
+  std::vector<int> contact_nodes;    // nodes in contact this step (before exclusion)
+  // Per tool plane: a node of it was in contact last step (carried) / the current triangle may
+  // touch a node of it (scratch).
+  std::vector<std::uint8_t> plane_had_contact;
+  std::vector<std::uint8_t> plane_open;
+  std::vector<std::uint64_t> contact_words;  // bitset over the tool nodes (orders contact_nodes; all 0 between steps)
+  int node_tests = 0;  // node tests the last sweep_tool_nodes call ran
+  // Per soft face hit this step: the leading tool node and its plane.
+  std::vector<std::int64_t> face_contact_stamp;
+  std::vector<int> face_plane;
+  std::vector<int> face_lead_node;
+  std::vector<int> contacted_faces;  // stage 2: faces hit by a tool node; stage 4: faces with a colliding soft node
+};
+
+struct PairExclusionData {  // stage 3 (pair_exclusion.cpp)
+  std::vector<std::int64_t> node_excluded_stamp;
+  std::vector<int> vector;  // the paper's exclusion vector (this step)
+};
+
+struct DisplacementData {  // stage 4 (enforced_displacement.cpp; in_solver: solver_projection.cpp)
   std::vector<std::int64_t> moved_stamp;   // displaced this step ...
   std::vector<int> moved_nodes;            // ... listed (their triangles have a colliding node)
-  std::vector<std::int64_t> hold_stamp;    // soft-node side memory: held on a tool plane ...
+  std::vector<std::int64_t> hold_stamp;    // carried: soft-node side memory: held on a tool plane ...
   std::vector<int> hold_plane;             // ... this one, at step hold_stamp
   std::vector<double> node_share;          // colliding node's share of its force (valid where moved_stamp == step):
                                            // 1 on the face, ramping to 0 over release_distance in front of it
-  std::vector<int> candidate_nodes;
-  std::vector<Eigen::Vector3d> iterate_tool_m;  // in_solver: each candidate's position after the last projection (tool frame, current pose)
-  // In-solver friction: where a held node sticks (tool frame; the node's position at the end of
-  // the step it was last held, or where it was first held this step), valid at friction_anchor_stamp,
+};
+
+struct SolverProjectionData {  // in_solver only (solver_projection.cpp, rim_projection.cpp)
+  std::vector<Eigen::Vector3d> iterate_tool_m;  // each candidate's position after the last projection (tool frame, current pose)
+  // Friction: where a held node sticks (carried; tool frame; the node's position at the end of the
+  // step it was last held, or where it was first held this step), valid at friction_anchor_stamp,
   // and the tangential correction friction has applied to it so far this step (tool frame, m; the
   // position-level friction impulse × h / m) with whether it was the whole move (stick) or the cone's share (slide).
   std::vector<Eigen::Vector3d> friction_anchor_tool_m;
   std::vector<std::int64_t> friction_anchor_stamp;
   std::vector<Eigen::Vector3d> friction_correction_tool_m;
   std::vector<std::uint8_t> friction_sliding;
-  // In-solver rim constraint: the displacement its projections gave a node this step (world, m),
-  // valid at rim_correction_stamp.
+  // Rim constraint: the displacement its projections gave a node this step (world, m), valid at
+  // rim_correction_stamp.
   std::vector<Eigen::Vector3d> rim_correction_world_m;
   std::vector<std::int64_t> rim_correction_stamp;
-  // Node sweep (node_sweep.cpp), per tool plane: a node of it was in contact last step / the
-  // current triangle may touch a node of it.
-  std::vector<std::uint8_t> sweep_plane_had_contact;
-  std::vector<std::uint8_t> sweep_plane_open;
-  std::vector<std::uint64_t> sweep_contact_words;  // bitset over the tool nodes (orders contact_nodes; all 0 between steps)
-  int sweep_node_tests = 0;  // node tests the last sweep_tool_nodes call ran (tests and measurements count these)
-  // Soft faces.
-  std::vector<std::int64_t> face_candidate_stamp;
-  std::vector<int> candidate_faces;
-  std::vector<std::int64_t> face_contact_stamp;
-  std::vector<int> face_plane;
-  std::vector<int> face_lead_node;
-  std::vector<int> contacted_faces;       // stage 3: faces hit by a tool node; stage 4: faces with a colliding soft node
+};
+
+struct ForceData {  // stage 5 (hunt_crossley_force.cpp): the ẋ filters, carried
   std::vector<std::int64_t> face_force_stamp;
   std::vector<std::int64_t> hc_stamp;   // last step the face was in contact (filter state valid)
   std::vector<double> hc_x_prev_m;
@@ -175,17 +204,16 @@ struct CollisionData {
   std::vector<std::int64_t> hc_corner_stamp;
   std::vector<double> hc_corner_x_prev_m;
   std::vector<double> hc_corner_rate_filtered_m_s;
+};
 
-  // ---- Broad phase only (broad_phase.cpp; sized on its first call) ----------------------------
-  std::vector<std::int64_t> broad_listed_stamp;      // soft node listed in candidate_nodes at this step
-  std::vector<int> broad_previous_candidates;        // last step's candidate nodes (re-tested directly)
-  std::vector<int> broad_scan_hits;                  // nodes inside the scan's union box this step
-  std::vector<int> broad_faces_kept;                 // faces the world-bounds pre-filter passed to the exact test
-  // What the last call visited (tests and the bench count these instead of timing them).
-  int broad_nodes_scanned = 0;        // soft nodes whose start/end positions the scan read (every node)
-  int broad_seed_nodes = 0;           // soft nodes whose own start/end box met the query
-  int broad_faces_tested = 0;         // soft faces reached and tested (pre-filter on their world bounds)
-  int broad_faces_transformed = 0;    // of those, faces the exact tool-frame test ran on (vertices transformed)
+struct CollisionData {
+  std::int64_t step = 0;
+  BroadPhaseData broad;
+  NodeSweepData sweep;
+  PairExclusionData exclusion;
+  DisplacementData displacement;
+  SolverProjectionData solver;
+  ForceData force;
 };
 
 // The step's frame quantities (rotations, translations, velocities, swept tool bounds) from the

@@ -19,7 +19,7 @@
 //     This covers the tool's area between nodes and its rim.
 // Colliding soft nodes = nodes moved this step, plus nodes held last step that are still within
 // release_distance in front of their plane (hysteresis against contact-set chatter; their force
-// share ramps smoothly from 1 on the face to 0 at release_distance, CollisionData::node_share). Every
+// share ramps smoothly from 1 on the face to 0 at release_distance, DisplacementData::node_share). Every
 // triangle around a colliding node is in the force set (paper: "at least one of the nodes
 // belonging to the triangle is in a colliding state"), pushing along its node's plane.
 // ray (the paper's Fig. 3 right): every tool node in contact, excluded or not, puts its triangle's
@@ -58,14 +58,14 @@ struct Writer {
   Eigen::Vector3d target_on_plane(int node, int plane_index) const {
     const ToolPlane& plane = model.tool.planes()[static_cast<std::size_t>(plane_index)];
     const double target = plane.offset_m + model.params.skin_m;
-    const Eigen::Vector3d& end = data.end_tool_m[static_cast<std::size_t>(node)];
+    const Eigen::Vector3d& end = data.broad.end_tool_m[static_cast<std::size_t>(node)];
     return end + (target - plane.normal_tool.dot(end)) * plane.normal_tool;
   }
 
   // Moves the node's end position onto `plane` (+ skin) if it is behind it.
   bool place_on_plane(int node, int plane_index) {
     const ToolPlane& plane = model.tool.planes()[static_cast<std::size_t>(plane_index)];
-    Eigen::Vector3d& p = data.end_tool_m[static_cast<std::size_t>(node)];
+    Eigen::Vector3d& p = data.broad.end_tool_m[static_cast<std::size_t>(node)];
     const double target = plane.offset_m + model.params.skin_m;
     if (plane.normal_tool.dot(p) >= target) return false;
     p = target_on_plane(node, plane_index);
@@ -75,27 +75,27 @@ struct Writer {
 
   void write(int node, int plane_index) {
     const auto n = static_cast<std::size_t>(node);
-    const Eigen::Vector3d p_world = frame.r_cur * data.end_tool_m[n] + frame.t_cur;
+    const Eigen::Vector3d p_world = frame.r_cur * data.broad.end_tool_m[n] + frame.t_cur;
     const Eigen::Vector3d v_world = frame.velocity_world_m_s + frame.angular_velocity_world.cross(p_world - frame.t_cur);
     btSoftBody::Node& soft_node = soft.m_nodes[node];
     soft_node.m_x.setValue(static_cast<btScalar>(p_world.x()), static_cast<btScalar>(p_world.y()),
                            static_cast<btScalar>(p_world.z()));
     soft_node.m_v.setValue(static_cast<btScalar>(v_world.x()), static_cast<btScalar>(v_world.y()),
                            static_cast<btScalar>(v_world.z()));
-    data.node_share[n] = 1.0;  // on the face: the node's whole share of the force
-    if (data.moved_stamp[n] != frame.step) {
-      data.moved_stamp[n] = frame.step;
-      data.moved_nodes.push_back(node);
+    data.displacement.node_share[n] = 1.0;  // on the face: the node's whole share of the force
+    if (data.displacement.moved_stamp[n] != frame.step) {
+      data.displacement.moved_stamp[n] = frame.step;
+      data.displacement.moved_nodes.push_back(node);
       ++counts.displaced;
     }
-    data.hold_stamp[n] = frame.step;
-    data.hold_plane[n] = plane_index;
+    data.displacement.hold_stamp[n] = frame.step;
+    data.displacement.hold_plane[n] = plane_index;
   }
 
   bool held_last_step_facing(int node, const Eigen::Vector3d& normal) const {
     const auto n = static_cast<std::size_t>(node);
-    if (data.hold_stamp[n] != frame.step - 1) return false;
-    return model.tool.planes()[static_cast<std::size_t>(data.hold_plane[n])].normal_tool.dot(normal) > kSameSideCosine;
+    if (data.displacement.hold_stamp[n] != frame.step - 1) return false;
+    return model.tool.planes()[static_cast<std::size_t>(data.displacement.hold_plane[n])].normal_tool.dot(normal) > kSameSideCosine;
   }
 
   // Whether moving the node's end position straight onto `plane` (+ skin) along its normal stays
@@ -109,7 +109,7 @@ struct Writer {
   // interior — and is no wrap.
   bool move_clears_tool(int node, int plane_index) const {
     const ToolPlane& target_plane = model.tool.planes()[static_cast<std::size_t>(plane_index)];
-    const Eigen::Vector3d& a = data.end_tool_m[static_cast<std::size_t>(node)];
+    const Eigen::Vector3d& a = data.broad.end_tool_m[static_cast<std::size_t>(node)];
     if (target_plane.normal_tool.dot(a) >= target_plane.offset_m + model.params.skin_m) return true;  // in front: nothing to move
     if (target_plane.normal_tool.dot(a) <= model.rim_plane_back_m[static_cast<std::size_t>(plane_index)]) return false;
     return segment_clears_tool(model.tool.planes(), a, target_on_plane(node, plane_index));
@@ -117,18 +117,18 @@ struct Writer {
 
   void paired_faces() {
     const double feasible_slack = model.params.contact_distance_m + model.params.skin_m;
-    for (const int face : data.contacted_faces) {
-      const int plane_index = data.face_plane[static_cast<std::size_t>(face)];
+    for (const int face : data.sweep.contacted_faces) {
+      const int plane_index = data.sweep.face_plane[static_cast<std::size_t>(face)];
       const ToolPlane& plane = model.tool.planes()[static_cast<std::size_t>(plane_index)];
       // Wrapping applies when the rim LEADS into the triangle (its node meets it head-on, as an
       // edge-first blade does); a rim node grazing a triangle at the side of a plate moving
       // face-first must not drag the vertices under the plate sideways onto its rim plane.
-      const int lead = data.face_lead_node[static_cast<std::size_t>(face)];
+      const int lead = data.sweep.face_lead_node[static_cast<std::size_t>(face)];
       const bool rim_leads = model.rim_plane[static_cast<std::size_t>(plane_index)] != 0 && lead >= 0 &&
-                             data.node_facing[static_cast<std::size_t>(lead)] < -kRimHeadOnCosine;
+                             data.sweep.node_facing[static_cast<std::size_t>(lead)] < -kRimHeadOnCosine;
       for (const int node : model.soft.face_nodes[static_cast<std::size_t>(face)]) {
         if (fixed(node)) continue;
-        const double start_height = plane.normal_tool.dot(data.start_tool_m[static_cast<std::size_t>(node)]);
+        const double start_height = plane.normal_tool.dot(data.broad.start_tool_m[static_cast<std::size_t>(node)]);
         const bool came_from_front = start_height >= plane.offset_m - feasible_slack;
         if (came_from_front || held_last_step_facing(node, plane.normal_tool) ||
             (rim_leads && move_clears_tool(node, plane_index)))
@@ -140,11 +140,11 @@ struct Writer {
   void guard() {
     const auto& planes = model.tool.planes();
     const std::size_t plane_count = planes.size();
-    for (const int node : data.candidate_nodes) {
+    for (const int node : data.broad.candidate_nodes) {
       if (fixed(node)) continue;
       const auto n = static_cast<std::size_t>(node);
-      const Eigen::Vector3d& a = data.start_tool_m[n];
-      const Eigen::Vector3d& b = data.end_tool_m[n];
+      const Eigen::Vector3d& a = data.broad.start_tool_m[n];
+      const Eigen::Vector3d& b = data.broad.end_tool_m[n];
       double t_enter = 0.0;
       double t_exit = 1.0;
       int enter_plane = -1;
@@ -176,8 +176,8 @@ struct Writer {
       if (misses || t_enter > t_exit) continue;
       int plane_index = enter_plane;
       if (plane_index < 0) {
-        if (data.hold_stamp[n] >= frame.step - 1 && data.hold_plane[n] >= 0) {
-          plane_index = data.hold_plane[n];
+        if (data.displacement.hold_stamp[n] >= frame.step - 1 && data.displacement.hold_plane[n] >= 0) {
+          plane_index = data.displacement.hold_plane[n];
         } else {
           plane_index = nearest_plane;  // started inside with no memory: the shallowest way out
         }
@@ -188,13 +188,13 @@ struct Writer {
 
   void ray_only() {
     const auto& plane_of_node = model.tool.plane_of_node();
-    for (const int i : data.contact_nodes) {
-      const int face = data.node_face[static_cast<std::size_t>(i)];
+    for (const int i : data.sweep.contact_nodes) {
+      const int face = data.sweep.node_face[static_cast<std::size_t>(i)];
       if (face < 0) continue;
       const int plane_index = plane_of_node[static_cast<std::size_t>(i)];
       for (const int node : model.soft.face_nodes[static_cast<std::size_t>(face)])
         if (!fixed(node)) place_on_plane(node, plane_index);
-      data.face_plane[static_cast<std::size_t>(face)] = plane_index;  // last writer, as placed
+      data.sweep.face_plane[static_cast<std::size_t>(face)] = plane_index;  // last writer, as placed
     }
   }
 };
@@ -221,7 +221,7 @@ bool segment_clears_tool(const std::vector<ToolPlane>& planes, const Eigen::Vect
 DisplacementCounts place_contact_nodes(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft, CollisionData& data,
                                        SoftNodeBounds* node_bounds) {
   Writer writer{model, frame, soft, data, DisplacementCounts{}};
-  data.moved_nodes.clear();
+  data.displacement.moved_nodes.clear();
   if (model.paired) {
     writer.paired_faces();
     writer.guard();
@@ -230,7 +230,7 @@ DisplacementCounts place_contact_nodes(const CollisionModel& model, const StepFr
   }
   // Every node written above is listed in moved_nodes (Writer::write).
   if (node_bounds != nullptr)
-    for (const int node : data.moved_nodes) node_bounds->extend(node, soft.m_nodes[node].m_x);
+    for (const int node : data.displacement.moved_nodes) node_bounds->extend(node, soft.m_nodes[node].m_x);
   return writer.counts;
 }
 
@@ -243,18 +243,18 @@ void hold_near_nodes(const CollisionModel& model, const StepFrame& frame, Collis
   // share by a few % only — the share's slope adds to the contact stiffness.
   const auto& planes = model.tool.planes();
   const double release_m = model.params.release_distance_m;
-  for (const int node : data.candidate_nodes) {
+  for (const int node : data.broad.candidate_nodes) {
     const auto n = static_cast<std::size_t>(node);
-    if (data.hold_stamp[n] != frame.step - 1 || data.moved_stamp[n] == frame.step) continue;
-    const int plane_index = data.hold_plane[n];
+    if (data.displacement.hold_stamp[n] != frame.step - 1 || data.displacement.moved_stamp[n] == frame.step) continue;
+    const int plane_index = data.displacement.hold_plane[n];
     const ToolPlane& plane = planes[static_cast<std::size_t>(plane_index)];
-    const double gap = plane.normal_tool.dot(data.end_tool_m[n]) - plane.offset_m;
+    const double gap = plane.normal_tool.dot(data.broad.end_tool_m[n]) - plane.offset_m;
     if (gap > release_m) continue;  // separated: released
     if (gap < 0.0) continue;  // pushed behind its plane with no tool node hitting it: released
-    data.node_share[n] = release_share(gap, release_m);
-    data.hold_stamp[n] = frame.step;  // lifted off the face it moves freely (only its side is remembered)
-    data.moved_stamp[n] = frame.step;
-    data.moved_nodes.push_back(node);
+    data.displacement.node_share[n] = release_share(gap, release_m);
+    data.displacement.hold_stamp[n] = frame.step;  // lifted off the face it moves freely (only its side is remembered)
+    data.displacement.moved_stamp[n] = frame.step;
+    data.displacement.moved_nodes.push_back(node);
   }
 }
 
@@ -265,12 +265,12 @@ namespace {
 // leading node only if it lies on that same plane.
 void add_force_face(const StepFrame& frame, CollisionData& data, int face, int plane_index) {
   const auto f = static_cast<std::size_t>(face);
-  if (data.face_force_stamp[f] == frame.step) return;
-  data.face_force_stamp[f] = frame.step;
-  const bool hit_on_same_plane = data.face_contact_stamp[f] == frame.step && data.face_plane[f] == plane_index;
-  if (!hit_on_same_plane) data.face_lead_node[f] = -1;
-  data.face_plane[f] = plane_index;
-  data.contacted_faces.push_back(face);
+  if (data.force.face_force_stamp[f] == frame.step) return;
+  data.force.face_force_stamp[f] = frame.step;
+  const bool hit_on_same_plane = data.sweep.face_contact_stamp[f] == frame.step && data.sweep.face_plane[f] == plane_index;
+  if (!hit_on_same_plane) data.sweep.face_lead_node[f] = -1;
+  data.sweep.face_plane[f] = plane_index;
+  data.sweep.contacted_faces.push_back(face);
 }
 
 }  // namespace
@@ -279,11 +279,11 @@ void collect_force_faces(const CollisionModel& model, const StepFrame& frame, Co
   // Paper: "the calculation of x is executed if and only if at least one of the nodes belonging to
   // the triangle is in a colliding state" — the force set is every triangle around a colliding
   // soft node (displaced this step, or held within the release distance).
-  data.contacted_faces.clear();
-  for (const int node : data.moved_nodes) {
+  data.sweep.contacted_faces.clear();
+  for (const int node : data.displacement.moved_nodes) {
     const auto n = static_cast<std::size_t>(node);
     for (int k = model.soft.faces_of_node_begin[n]; k < model.soft.faces_of_node_begin[n + 1]; ++k)
-      add_force_face(frame, data, model.soft.faces_of_node[static_cast<std::size_t>(k)], data.hold_plane[n]);
+      add_force_face(frame, data, model.soft.faces_of_node[static_cast<std::size_t>(k)], data.displacement.hold_plane[n]);
   }
 }
 

@@ -97,10 +97,10 @@ void rim_contact_forces(const CollisionModel& model, const StepFrame& frame, con
   const auto& planes = model.tool.planes();
   const double release_m = model.params.release_distance_m;
   const double band_m = model.tool.thickness_m() + model.params.solver_reach_m;
-  for (const int face : data.candidate_faces) {
+  for (const int face : data.broad.candidate_faces) {
     const auto f = static_cast<std::size_t>(face);
     const std::array<int, 3>& nodes = model.soft.face_nodes[f];
-    if (std::any_of(nodes.begin(), nodes.end(), [&](int node) { return data.moved_stamp[static_cast<std::size_t>(node)] == frame.step; })) continue;
+    if (std::any_of(nodes.begin(), nodes.end(), [&](int node) { return data.displacement.moved_stamp[static_cast<std::size_t>(node)] == frame.step; })) continue;
     SoftTriangleInTool triangle;
     if (!soft_triangle_in_tool(model, frame, soft, face, triangle)) continue;
     const Eigen::Vector3d& normal = triangle.normal;
@@ -134,7 +134,7 @@ void rim_contact_forces(const CollisionModel& model, const StepFrame& frame, con
       }
     }
     if (plane_index < 0) continue;
-    const double rate = filtered_rate(data.hc_stamp[f], data.hc_x_prev_m[f], data.hc_rate_filtered_m_s[f], frame.step, x_m, x_m, frame.dt_s, alpha);
+    const double rate = filtered_rate(data.force.hc_stamp[f], data.force.hc_x_prev_m[f], data.force.hc_rate_filtered_m_s[f], frame.step, x_m, x_m, frame.dt_s, alpha);
     const double area_weight = hc.per_unit_area ? model.soft.rest_area_m2[f] : 1.0;
     const double x_pow_n = std::pow(x_m, hc.n);
     const double force = share * (area_weight / 3.0) * std::max(0.0, hc.k * x_pow_n + hc.lambda * x_pow_n * rate);
@@ -152,10 +152,10 @@ void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, co
   const double alpha = frame.dt_s / (frame.dt_s + time_constant_s);
   const auto& planes = model.tool.planes();
   const bool normal_measure = hc.measure == DeformationMeasure::kNormalDisplacement;
-  for (const int face : data.contacted_faces) {
+  for (const int face : data.sweep.contacted_faces) {
     const auto f = static_cast<std::size_t>(face);
     const Eigen::Vector3d c_now = centroid(model.soft, soft, face, false);
-    const int plane_index = data.face_plane[f];
+    const int plane_index = data.sweep.face_plane[f];
     const ToolPlane& plane = planes[static_cast<std::size_t>(plane_index)];
     const Eigen::Vector3d normal_world = frame.r_cur * plane.normal_tool;
     const Eigen::Vector3d normal_prev_world = frame.r_prev * plane.normal_tool;
@@ -172,8 +172,8 @@ void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, co
       for (std::size_t corner = 0; corner < 3; ++corner) {
         const int node = model.soft.face_nodes[f][corner];
         const auto v = static_cast<std::size_t>(node);
-        if (data.moved_stamp[v] != frame.step) continue;  // not a colliding vertex
-        const double share = data.node_share[v];
+        if (data.displacement.moved_stamp[v] != frame.step) continue;  // not a colliding vertex
+        const double share = data.displacement.node_share[v];
         const Eigen::Vector3d& rest = model.soft.rest_node_world_m[v];
         const double x = std::max(0.0, plane.offset_m + normal_world.dot(frame.t_cur - rest));
         const double x_start = std::max(0.0, plane.offset_m + normal_prev_world.dot(frame.t_prev - rest));
@@ -184,11 +184,11 @@ void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, co
         // rim): then last step's x was taken along another normal, and differencing across the
         // switch turned a change of plane into an indentation rate (mm per ms is m/s, × λ). The
         // filter restarts from x_start at a switch, as at first contact.
-        if (data.hc_corner_stamp[slot] == frame.step - 1 &&
-            std::abs(data.hc_corner_x_prev_m[slot] - x_start) > kPlaneSwitchTolerance_m)
-          data.hc_corner_stamp[slot] = -1;
-        const double rate = filtered_rate(data.hc_corner_stamp[slot], data.hc_corner_x_prev_m[slot],
-                                          data.hc_corner_rate_filtered_m_s[slot], frame.step, x, x_start, frame.dt_s, alpha);
+        if (data.force.hc_corner_stamp[slot] == frame.step - 1 &&
+            std::abs(data.force.hc_corner_x_prev_m[slot] - x_start) > kPlaneSwitchTolerance_m)
+          data.force.hc_corner_stamp[slot] = -1;
+        const double rate = filtered_rate(data.force.hc_corner_stamp[slot], data.force.hc_corner_x_prev_m[slot],
+                                          data.force.hc_corner_rate_filtered_m_s[slot], frame.step, x, x_start, frame.dt_s, alpha);
         const double x_pow_n = std::pow(x, hc.n);
         force += share * (area_weight / 3.0) * std::max(0.0, hc.k * x_pow_n + hc.lambda * x_pow_n * rate);
         share_sum += share;
@@ -203,7 +203,7 @@ void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, co
       const double x = (c_now - model.soft.rest_centroid_world_m[f]).norm();
       const double x_start = (centroid(model.soft, soft, face, true) - model.soft.rest_centroid_world_m[f]).norm();
       const double rate =
-          filtered_rate(data.hc_stamp[f], data.hc_x_prev_m[f], data.hc_rate_filtered_m_s[f], frame.step, x, x_start, frame.dt_s, alpha);
+          filtered_rate(data.force.hc_stamp[f], data.force.hc_x_prev_m[f], data.force.hc_rate_filtered_m_s[f], frame.step, x, x_start, frame.dt_s, alpha);
       // Per unit area the sum is a quadrature of k·xⁿ over the contacted surface. A triangle at the
       // rim of the patch has only some vertices on the tool: counting its whole area there adds a
       // ring one edge wide (an O(h) error — with the whole area, 1280/5120/20480 faces gave
@@ -212,7 +212,7 @@ void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, co
       double contacted_share = 1.0;
       if (hc.per_unit_area) {
         int colliding = 0;
-        for (const int node : model.soft.face_nodes[f]) colliding += data.moved_stamp[static_cast<std::size_t>(node)] == frame.step ? 1 : 0;
+        for (const int node : model.soft.face_nodes[f]) colliding += data.displacement.moved_stamp[static_cast<std::size_t>(node)] == frame.step ? 1 : 0;
         contacted_share = colliding / 3.0;
       }
       weight = contacted_share * area_weight;
@@ -221,7 +221,7 @@ void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, co
       x_record = x;
       rate_record = rate;
     }
-    add_contact(ContactRecord{face, data.face_lead_node[f], plane_index, model.params.jaw, c_now, normal_world, x_record, rate_record, weight, force}, out);
+    add_contact(ContactRecord{face, data.sweep.face_lead_node[f], plane_index, model.params.jaw, c_now, normal_world, x_record, rate_record, weight, force}, out);
   }
   if (model.params.response == ContactResponse::kInSolver) rim_contact_forces(model, frame, soft, data, alpha, out);
 }

@@ -288,13 +288,13 @@ void prepare_node_sweep(const ToolNodes& tool, ToolNodeBins& bins) {
 
 void sweep_tool_nodes(const CollisionModel& model, CollisionData& data) {
   // Which planes had a node in contact last step (before this step's lists are reset).
-  std::fill(data.sweep_plane_had_contact.begin(), data.sweep_plane_had_contact.end(), 0);
-  for (const int node : data.contact_nodes)
-    if (data.node_face[static_cast<std::size_t>(node)] >= 0)
-      data.sweep_plane_had_contact[static_cast<std::size_t>(model.tool.plane_of_node()[static_cast<std::size_t>(node)])] = 1;
-  data.node_face.swap(data.node_face_prev);
-  std::fill(data.node_face.begin(), data.node_face.end(), -1);
-  data.contact_nodes.clear();
+  std::fill(data.sweep.plane_had_contact.begin(), data.sweep.plane_had_contact.end(), 0);
+  for (const int node : data.sweep.contact_nodes)
+    if (data.sweep.node_face[static_cast<std::size_t>(node)] >= 0)
+      data.sweep.plane_had_contact[static_cast<std::size_t>(model.tool.plane_of_node()[static_cast<std::size_t>(node)])] = 1;
+  data.sweep.node_face.swap(data.sweep.node_face_prev);
+  std::fill(data.sweep.node_face.begin(), data.sweep.node_face.end(), -1);
+  data.sweep.contact_nodes.clear();
   const auto& normals = model.tool.normals_tool();
   const std::size_t plane_count = model.bins.plane_bounds_m.size();
   const ToolNodeBins& bins = model.bins;
@@ -303,15 +303,15 @@ void sweep_tool_nodes(const CollisionModel& model, CollisionData& data) {
   // How far behind a triangle a node may start and still be accepted (the node test's start
   // condition): the memory depth once any node was in contact last step.
   const bool any_had_contact =
-      std::any_of(data.sweep_plane_had_contact.begin(), data.sweep_plane_had_contact.end(), [](std::uint8_t had) { return had != 0; });
+      std::any_of(data.sweep.plane_had_contact.begin(), data.sweep.plane_had_contact.end(), [](std::uint8_t had) { return had != 0; });
   const double start_depth = any_had_contact ? std::max(contact, model.memory_depth_m) : contact;
-  data.sweep_node_tests = 0;
+  data.sweep.node_tests = 0;
   const int axis_w = 3 - bins.axis_u - bins.axis_v;  // the tool's thin axis
 
-  for (const int face : data.candidate_faces) {
+  for (const int face : data.broad.candidate_faces) {
     const auto& v = model.soft.face_nodes[static_cast<std::size_t>(face)];
-    const auto at_start = [&](int k) { return data.start_tool_m[static_cast<std::size_t>(v[static_cast<std::size_t>(k)])]; };
-    const auto at_end = [&](int k) { return data.end_tool_m[static_cast<std::size_t>(v[static_cast<std::size_t>(k)])]; };
+    const auto at_start = [&](int k) { return data.broad.start_tool_m[static_cast<std::size_t>(v[static_cast<std::size_t>(k)])]; };
+    const auto at_end = [&](int k) { return data.broad.end_tool_m[static_cast<std::size_t>(v[static_cast<std::size_t>(k)])]; };
     const Triangle start = make_triangle(at_start(0), at_start(1), at_start(2), sign);
     const Triangle end = make_triangle(at_end(0), at_end(1), at_end(2), sign);
     if (!start.valid || !end.valid) continue;
@@ -367,10 +367,10 @@ void sweep_tool_nodes(const CollisionModel& model, CollisionData& data) {
       if (open && min_over_box(end.normal, d_end, under) > contact + kPlaneSkipSlack_m) open = false;
       if (open) {
         const double s_start_max = max_over_box(start.normal, d_start, under);
-        const bool memory_may_hold = data.sweep_plane_had_contact[plane] != 0 && s_start_max >= -model.memory_depth_m - kPlaneSkipSlack_m;
+        const bool memory_may_hold = data.sweep.plane_had_contact[plane] != 0 && s_start_max >= -model.memory_depth_m - kPlaneSkipSlack_m;
         if (s_start_max < -contact - kPlaneSkipSlack_m && !memory_may_hold) open = false;
       }
-      data.sweep_plane_open[plane] = open ? 1 : 0;
+      data.sweep.plane_open[plane] = open ? 1 : 0;
       any_open = any_open || open;
     }
     if (!any_open) continue;
@@ -397,13 +397,13 @@ void sweep_tool_nodes(const CollisionModel& model, CollisionData& data) {
     const auto test_node = [&](int b) {
       const auto slot = static_cast<std::size_t>(b);
       const Eigen::Vector3d& p = bins.plane_cell_positions_m[slot];
-      ++data.sweep_node_tests;
+      ++data.sweep.node_tests;
       const double s_end = end.normal.dot(p - end.a);
       if (s_end > contact) return;
       const int node = bins.plane_cell_nodes[slot];
       const auto n = static_cast<std::size_t>(node);
       const double s_start = start.normal.dot(p - start.a);
-      const bool was_in_contact = data.node_face_prev[n] >= 0;
+      const bool was_in_contact = data.sweep.node_face_prev[n] >= 0;
       if (s_start < -contact && !(was_in_contact && s_start >= -memory_depth)) return;
       const double tau = s_start > contact ? (s_start - contact) / (s_start - s_end) : 1.0;
       bool inside = false;
@@ -421,16 +421,16 @@ void sweep_tool_nodes(const CollisionModel& model, CollisionData& data) {
         }
       }
       if (!inside) return;
-      const bool first = data.node_face[n] < 0;
-      if (first || tau < data.node_tau[n] - 1e-12) {
-        if (first) data.contact_nodes.push_back(node);
-        data.node_face[n] = face;
-        data.node_tau[n] = tau;
-        data.node_facing[n] = normals[n].dot(normal_at_tau);
+      const bool first = data.sweep.node_face[n] < 0;
+      if (first || tau < data.sweep.node_tau[n] - 1e-12) {
+        if (first) data.sweep.contact_nodes.push_back(node);
+        data.sweep.node_face[n] = face;
+        data.sweep.node_tau[n] = tau;
+        data.sweep.node_facing[n] = normals[n].dot(normal_at_tau);
       }
     };
     for (std::size_t plane = 0; plane < plane_count; ++plane) {
-      if (data.sweep_plane_open[plane] == 0) continue;
+      if (data.sweep.plane_open[plane] == 0) continue;
       const Eigen::AlignedBox3d& plane_box = bins.plane_bounds_m[plane];
       const int* cell_begin = &bins.plane_cell_begin[plane * cells_in_plane];
       const double w_term = n_w > 0.0 ? n_w * plane_box.min()[axis_w] : n_w * plane_box.max()[axis_w];
@@ -474,20 +474,20 @@ void sweep_tool_nodes(const CollisionModel& model, CollisionData& data) {
   }
   // Deterministic order: node index order, through a bitset of the tool nodes (linear in the tool
   // nodes / 64 plus the contacts, where sorting a deep press's hundreds of contact nodes cost ~6 %).
-  for (const int node : data.contact_nodes)
-    data.sweep_contact_words[static_cast<std::size_t>(node) >> 6U] |= std::uint64_t{1} << (static_cast<unsigned>(node) & 63U);
-  data.contact_nodes.clear();
-  for (std::size_t word = 0; word < data.sweep_contact_words.size(); ++word) {
-    for (std::uint64_t bits = data.sweep_contact_words[word]; bits != 0; bits &= bits - 1)
-      data.contact_nodes.push_back(static_cast<int>(64 * word) + std::countr_zero(bits));
-    data.sweep_contact_words[word] = 0;
+  for (const int node : data.sweep.contact_nodes)
+    data.sweep.contact_words[static_cast<std::size_t>(node) >> 6U] |= std::uint64_t{1} << (static_cast<unsigned>(node) & 63U);
+  data.sweep.contact_nodes.clear();
+  for (std::size_t word = 0; word < data.sweep.contact_words.size(); ++word) {
+    for (std::uint64_t bits = data.sweep.contact_words[word]; bits != 0; bits &= bits - 1)
+      data.sweep.contact_nodes.push_back(static_cast<int>(64 * word) + std::countr_zero(bits));
+    data.sweep.contact_words[word] = 0;
   }
   // Side memory: how many consecutive steps each node has been in contact. Kept for the nodes in
   // contact only (the pair rule reads the age of nodes in contact, and a node's count restarts at
   // 1 when it was not in contact last step), not over every tool node each step.
-  for (const int node : data.contact_nodes) {
+  for (const int node : data.sweep.contact_nodes) {
     const auto i = static_cast<std::size_t>(node);
-    data.node_age[i] = data.node_face_prev[i] >= 0 ? data.node_age[i] + 1 : 1;
+    data.sweep.node_age[i] = data.sweep.node_face_prev[i] >= 0 ? data.sweep.node_age[i] + 1 : 1;
   }
 }
 

@@ -31,9 +31,9 @@ constexpr double kFacingMargin = 0.25;
 bool leads(const CollisionData& data, int i, int j) {
   const auto a = static_cast<std::size_t>(i);
   const auto b = static_cast<std::size_t>(j);
-  if (data.node_age[a] != data.node_age[b]) return data.node_age[a] > data.node_age[b];
-  if (std::abs(data.node_facing[a] - data.node_facing[b]) > kTie) return data.node_facing[a] < data.node_facing[b];
-  if (std::abs(data.node_tau[a] - data.node_tau[b]) > kTie) return data.node_tau[a] < data.node_tau[b];
+  if (data.sweep.node_age[a] != data.sweep.node_age[b]) return data.sweep.node_age[a] > data.sweep.node_age[b];
+  if (std::abs(data.sweep.node_facing[a] - data.sweep.node_facing[b]) > kTie) return data.sweep.node_facing[a] < data.sweep.node_facing[b];
+  if (std::abs(data.sweep.node_tau[a] - data.sweep.node_tau[b]) > kTie) return data.sweep.node_tau[a] < data.sweep.node_tau[b];
   return i < j;
 }
 
@@ -50,22 +50,22 @@ bool places_face(const CollisionModel& model, const CollisionData& data, int i, 
   const auto a = static_cast<std::size_t>(i);
   const auto b = static_cast<std::size_t>(j);
   if ((edge[a] != 0 || edge[b] != 0) && plane_of_node[a] != plane_of_node[b] &&
-      std::abs(data.node_facing[a] - data.node_facing[b]) > kFacingMargin)
-    return data.node_facing[a] < data.node_facing[b];
+      std::abs(data.sweep.node_facing[a] - data.sweep.node_facing[b]) > kFacingMargin)
+    return data.sweep.node_facing[a] < data.sweep.node_facing[b];
   return leads(data, i, j);
 }
 
-bool in_contact(const CollisionData& data, int node) { return node >= 0 && data.node_face[static_cast<std::size_t>(node)] >= 0; }
+bool in_contact(const CollisionData& data, int node) { return node >= 0 && data.sweep.node_face[static_cast<std::size_t>(node)] >= 0; }
 
 }  // namespace
 
 int exclude_infeasible_pairs(const CollisionModel& model, CollisionData& data) {
-  data.exclusion.clear();
+  data.exclusion.vector.clear();
   const auto& pair_of = model.tool.pair_of();
   const auto& by_begin = model.tool.paired_by_begin();
   const auto& by_nodes = model.tool.paired_by_nodes();
   if (model.paired && model.tool.is_thin()) {
-    for (const int i : data.contact_nodes) {
+    for (const int i : data.sweep.contact_nodes) {
       bool loses = false;
       const int pair = pair_of[static_cast<std::size_t>(i)];
       if (in_contact(data, pair) && !leads(data, i, pair)) loses = true;
@@ -73,39 +73,39 @@ int exclude_infeasible_pairs(const CollisionModel& model, CollisionData& data) {
         const int other = by_nodes[static_cast<std::size_t>(k)];
         if (in_contact(data, other) && !leads(data, i, other)) loses = true;
       }
-      if (loses) data.exclusion.push_back(i);
+      if (loses) data.exclusion.vector.push_back(i);
     }
     // Decisions above were taken on the contact state before any exclusion (the cross-check is
     // symmetric); now the excluded nodes stop colliding for this step and lose their memory.
-    for (const int i : data.exclusion) {
-      data.node_excluded_stamp[static_cast<std::size_t>(i)] = data.step;
-      data.node_face[static_cast<std::size_t>(i)] = -1;
-      data.node_age[static_cast<std::size_t>(i)] = 0;
+    for (const int i : data.exclusion.vector) {
+      data.exclusion.node_excluded_stamp[static_cast<std::size_t>(i)] = data.step;
+      data.sweep.node_face[static_cast<std::size_t>(i)] = -1;
+      data.sweep.node_age[static_cast<std::size_t>(i)] = 0;
     }
   }
   // Both-face contacts left (the ray-only variant's instability; 0 for paired by construction).
   int both_face = 0;
-  for (const int i : data.contact_nodes) {
+  for (const int i : data.sweep.contact_nodes) {
     const int pair = pair_of[static_cast<std::size_t>(i)];
     if (!in_contact(data, i) || !in_contact(data, pair)) continue;
     // Count a mutual pair once, a one-way pair from its source.
     if (pair_of[static_cast<std::size_t>(pair)] != i || i < pair) ++both_face;
   }
   // Contacted faces and the plane each is placed on.
-  data.contacted_faces.clear();
+  data.sweep.contacted_faces.clear();
   const auto& plane_of_node = model.tool.plane_of_node();
-  for (const int i : data.contact_nodes) {
-    const int face = data.node_face[static_cast<std::size_t>(i)];
+  for (const int i : data.sweep.contact_nodes) {
+    const int face = data.sweep.node_face[static_cast<std::size_t>(i)];
     if (face < 0) continue;
     const auto f = static_cast<std::size_t>(face);
-    if (data.face_contact_stamp[f] != data.step) {
-      data.face_contact_stamp[f] = data.step;
-      data.contacted_faces.push_back(face);
-      data.face_lead_node[f] = i;
-      data.face_plane[f] = plane_of_node[static_cast<std::size_t>(i)];
-    } else if (model.paired && places_face(model, data, i, data.face_lead_node[f])) {
-      data.face_lead_node[f] = i;
-      data.face_plane[f] = plane_of_node[static_cast<std::size_t>(i)];
+    if (data.sweep.face_contact_stamp[f] != data.step) {
+      data.sweep.face_contact_stamp[f] = data.step;
+      data.sweep.contacted_faces.push_back(face);
+      data.sweep.face_lead_node[f] = i;
+      data.sweep.face_plane[f] = plane_of_node[static_cast<std::size_t>(i)];
+    } else if (model.paired && places_face(model, data, i, data.sweep.face_lead_node[f])) {
+      data.sweep.face_lead_node[f] = i;
+      data.sweep.face_plane[f] = plane_of_node[static_cast<std::size_t>(i)];
     }
   }
   return both_face;

@@ -104,8 +104,8 @@ bool separated_by_a_held_plane(const CollisionModel& model, const StepFrame& fra
                                const SoftTriangleInTool& triangle) {
   for (const int node : nodes) {
     const auto n = static_cast<std::size_t>(node);
-    if (data.hold_stamp[n] != frame.step || data.hold_plane[n] < 0) continue;
-    const ToolPlane& plane = model.tool.planes()[static_cast<std::size_t>(data.hold_plane[n])];
+    if (data.displacement.hold_stamp[n] != frame.step || data.displacement.hold_plane[n] < 0) continue;
+    const ToolPlane& plane = model.tool.planes()[static_cast<std::size_t>(data.displacement.hold_plane[n])];
     if (plane.normal_tool.dot(triangle.x[0]) >= plane.offset_m && plane.normal_tool.dot(triangle.x[1]) >= plane.offset_m &&
         plane.normal_tool.dot(triangle.x[2]) >= plane.offset_m)
       return true;
@@ -229,7 +229,7 @@ int project_rim_contacts(const CollisionModel& model, const StepFrame& frame, bt
   // contact, not a cut. Ten skins of slack leave it alone; the cut metric counts from 0.1 mm.
   const double tolerance_m = 10.0 * model.params.skin_m;
   int projected = 0;
-  for (const int face : data.candidate_faces) {
+  for (const int face : data.broad.candidate_faces) {
     const std::array<int, 3>& nodes = model.soft.face_nodes[static_cast<std::size_t>(face)];
     std::array<double, 3> inverse_mass{};
     std::array<double, 3> body_inverse_mass{};
@@ -237,7 +237,7 @@ int project_rim_contacts(const CollisionModel& model, const StepFrame& frame, bt
       // A node held on a tool face this step is in contact with the rigid tool already: moving it
       // would break that contact, so the rim moves the free corners only.
       body_inverse_mass[k] = soft.m_nodes[nodes[k]].m_im;
-      inverse_mass[k] = (data.hold_stamp[static_cast<std::size_t>(nodes[k])] == frame.step) ? 0.0 : body_inverse_mass[k];
+      inverse_mass[k] = (data.displacement.hold_stamp[static_cast<std::size_t>(nodes[k])] == frame.step) ? 0.0 : body_inverse_mass[k];
     }
     if (body_inverse_mass[0] + body_inverse_mass[1] + body_inverse_mass[2] == 0.0) continue;
     SoftTriangleInTool triangle;
@@ -276,11 +276,11 @@ int project_rim_contacts(const CollisionModel& model, const StepFrame& frame, bt
       const Eigen::Vector3d move_tool = -triangle.normal * (depth_m * w[k] * inverse_mass[k] / weight_sum);
       write_tool_position(frame, triangle.x[k] + move_tool, soft.m_nodes[nodes[k]].m_x);
       const auto n = static_cast<std::size_t>(nodes[k]);
-      if (data.rim_correction_stamp[n] != frame.step) {
-        data.rim_correction_stamp[n] = frame.step;
-        data.rim_correction_world_m[n].setZero();
+      if (data.solver.rim_correction_stamp[n] != frame.step) {
+        data.solver.rim_correction_stamp[n] = frame.step;
+        data.solver.rim_correction_world_m[n].setZero();
       }
-      data.rim_correction_world_m[n] += frame.r_cur * move_tool;
+      data.solver.rim_correction_world_m[n] += frame.r_cur * move_tool;
     }
     ++projected;
   }
@@ -296,10 +296,10 @@ int project_rim_contacts(const CollisionModel& model, const StepFrame& frame, bt
 // push leaves the corner no faster along it than the tool moves there, so a corner the tool
 // carries keeps the tool's speed, and a resting one stays at rest.
 void inelastic_rim_velocities(const StepFrame& frame, btSoftBody& soft, const CollisionData& data) {
-  for (const int node : data.candidate_nodes) {
+  for (const int node : data.broad.candidate_nodes) {
     const auto n = static_cast<std::size_t>(node);
-    if (data.rim_correction_stamp[n] != frame.step) continue;
-    const Eigen::Vector3d& push_m = data.rim_correction_world_m[n];
+    if (data.solver.rim_correction_stamp[n] != frame.step) continue;
+    const Eigen::Vector3d& push_m = data.solver.rim_correction_world_m[n];
     const double push_length_m = push_m.norm();
     if (!(push_length_m > 0.0)) continue;
     const Eigen::Vector3d direction = push_m / push_length_m;

@@ -48,9 +48,9 @@ int exit_plane(const CollisionModel& model, const StepFrame& frame, const Collis
   const auto& planes = model.tool.planes();
   const auto n = static_cast<std::size_t>(node);
   const double reach_m = model.tool.thickness_m() + model.params.skin_m;
-  if (data.hold_stamp[n] == frame.step - 1 && data.hold_plane[n] >= 0) {
-    const ToolPlane& held = planes[static_cast<std::size_t>(data.hold_plane[n])];
-    if (held.offset_m - held.normal_tool.dot(p_tool) <= reach_m) return data.hold_plane[n];
+  if (data.displacement.hold_stamp[n] == frame.step - 1 && data.displacement.hold_plane[n] >= 0) {
+    const ToolPlane& held = planes[static_cast<std::size_t>(data.displacement.hold_plane[n])];
+    if (held.offset_m - held.normal_tool.dot(p_tool) <= reach_m) return data.displacement.hold_plane[n];
   }
   double t_enter = 0.0;
   int enter_plane = -1;
@@ -77,17 +77,17 @@ int exit_plane(const CollisionModel& model, const StepFrame& frame, const Collis
 }  // namespace
 
 void start_iterates(const CollisionModel& /*model*/, const StepFrame& frame, const btSoftBody& soft, CollisionData& data) {
-  for (const int node : data.candidate_nodes) {
+  for (const int node : data.broad.candidate_nodes) {
     const auto n = static_cast<std::size_t>(node);
     const Eigen::Vector3d p = to_tool(frame, soft.m_nodes[node].m_x);
-    data.iterate_tool_m[n] = p;
-    data.friction_correction_tool_m[n].setZero();
-    data.friction_sliding[n] = 0;
-    if (data.hold_stamp[n] != frame.step) continue;
+    data.solver.iterate_tool_m[n] = p;
+    data.solver.friction_correction_tool_m[n].setZero();
+    data.solver.friction_sliding[n] = 0;
+    if (data.displacement.hold_stamp[n] != frame.step) continue;
     // Placed by the detection: a node not held last step sticks where it was placed.
-    if (data.friction_anchor_stamp[n] != frame.step - 1) {
-      data.friction_anchor_tool_m[n] = p;
-      data.friction_anchor_stamp[n] = frame.step;
+    if (data.solver.friction_anchor_stamp[n] != frame.step - 1) {
+      data.solver.friction_anchor_tool_m[n] = p;
+      data.solver.friction_anchor_stamp[n] = frame.step;
     }
   }
 }
@@ -98,26 +98,26 @@ int project_contacts(const CollisionModel& model, const StepFrame& frame, btSoft
   const double mu_static = model.params.friction_static_ratio;
   const double mu_kinetic = model.params.friction_kinetic_ratio;
   int projected = 0;
-  for (const int node : data.candidate_nodes) {
+  for (const int node : data.broad.candidate_nodes) {
     btSoftBody::Node& soft_node = soft.m_nodes[node];
     if (soft_node.m_im == 0) continue;  // fixed nodes are never moved
     const auto n = static_cast<std::size_t>(node);
     Eigen::Vector3d p = to_tool(frame, soft_node.m_x);
     int plane_index = -1;
-    if (data.hold_stamp[n] == frame.step) {
-      plane_index = data.hold_plane[n];
+    if (data.displacement.hold_stamp[n] == frame.step) {
+      plane_index = data.displacement.hold_plane[n];
     } else {
       // Inside the tool now, or passed through it since the last projection (an iteration moves
       // a node by up to a link's correction, more than a 1 mm blade is thick): out through the
       // face it entered by on that move.
-      const Eigen::Vector3d& a = data.iterate_tool_m[n];
+      const Eigen::Vector3d& a = data.solver.iterate_tool_m[n];
       if (segment_clears_tool(planes, a, p)) {
-        data.iterate_tool_m[n] = p;
+        data.solver.iterate_tool_m[n] = p;
         continue;
       }
       plane_index = exit_plane(model, frame, data, node, a, p);
-      data.hold_stamp[n] = frame.step;
-      data.hold_plane[n] = plane_index;
+      data.displacement.hold_stamp[n] = frame.step;
+      data.displacement.hold_plane[n] = plane_index;
     }
     const ToolPlane& plane = planes[static_cast<std::size_t>(plane_index)];
     const double push_m = plane.offset_m + skin_m - plane.normal_tool.dot(p);
@@ -126,27 +126,27 @@ int project_contacts(const CollisionModel& model, const StepFrame& frame, btSoft
       p += push_m * plane.normal_tool;
       moved = true;
     }
-    if (data.friction_anchor_stamp[n] < frame.step - 1) {
+    if (data.solver.friction_anchor_stamp[n] < frame.step - 1) {
       // Caught by this iteration: it sticks where it was put out.
-      data.friction_anchor_tool_m[n] = p;
-      data.friction_anchor_stamp[n] = frame.step;
+      data.solver.friction_anchor_tool_m[n] = p;
+      data.solver.friction_anchor_stamp[n] = frame.step;
     }
     if (mu_static > 0.0) {
       // Coulomb at position level: the tangential move since the anchor that friction has not
       // already undone this step, against the cone of the node's normal impulse.
       const double normal_force_n = held_node_normal_force(model, frame, node, plane, plane.normal_tool.dot(p) - plane.offset_m);
-      Eigen::Vector3d& correction = data.friction_correction_tool_m[n];
-      Eigen::Vector3d free_slip = p - data.friction_anchor_tool_m[n] - correction;
+      Eigen::Vector3d& correction = data.solver.friction_correction_tool_m[n];
+      Eigen::Vector3d free_slip = p - data.solver.friction_anchor_tool_m[n] - correction;
       free_slip -= plane.normal_tool.dot(free_slip) * plane.normal_tool;
       const double free_slip_m = free_slip.norm();
       const double cone_m = normal_force_n * frame.dt_s * frame.dt_s * soft_node.m_im;  // F_n·h²/m
       Eigen::Vector3d wanted = Eigen::Vector3d::Zero();
-      data.friction_sliding[n] = 0;
+      data.solver.friction_sliding[n] = 0;
       if (free_slip_m <= mu_static * cone_m) {
         wanted = -free_slip;
       } else if (free_slip_m > 0.0) {
         wanted = -free_slip * (mu_kinetic * cone_m / free_slip_m);
-        data.friction_sliding[n] = 1;
+        data.solver.friction_sliding[n] = 1;
       }
       if (wanted != correction) {
         p += wanted - correction;
@@ -154,7 +154,7 @@ int project_contacts(const CollisionModel& model, const StepFrame& frame, btSoft
         moved = true;
       }
     }
-    data.iterate_tool_m[n] = p;
+    data.solver.iterate_tool_m[n] = p;
     if (!moved) continue;
     write_tool_position(frame, p, soft_node.m_x);
     ++projected;
@@ -179,15 +179,15 @@ void friction_force_on_tool(const CollisionModel& model, const StepFrame& frame,
   if (!(model.params.friction_static_ratio > 0.0)) return;
   Eigen::Vector3d force_tool = Eigen::Vector3d::Zero();
   const double inverse_h2 = 1.0 / (frame.dt_s * frame.dt_s);
-  for (const int node : data.candidate_nodes) {
+  for (const int node : data.broad.candidate_nodes) {
     const auto n = static_cast<std::size_t>(node);
     const double im = soft.m_nodes[node].m_im;
     if (im == 0.0) continue;
-    const Eigen::Vector3d& correction = data.friction_correction_tool_m[n];
+    const Eigen::Vector3d& correction = data.solver.friction_correction_tool_m[n];
     if (correction.isZero(0.0)) continue;
     // The correction moved the node by −(its tangential pull); the tool takes the reaction.
     force_tool -= correction * (inverse_h2 / im);
-    (data.friction_sliding[n] != 0 ? out.sliding_nodes : out.sticking_nodes) += 1;
+    (data.solver.friction_sliding[n] != 0 ? out.sliding_nodes : out.sticking_nodes) += 1;
   }
   const Eigen::Vector3d force_world = frame.r_cur * force_tool;
   out.friction_force_on_tool_world_n += force_world;
@@ -197,30 +197,30 @@ void friction_force_on_tool(const CollisionModel& model, const StepFrame& frame,
 void take_solved_shares(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data) {
   const auto& planes = model.tool.planes();
   const double release_m = model.params.release_distance_m;
-  data.moved_nodes.clear();
-  for (const int node : data.candidate_nodes) {
+  data.displacement.moved_nodes.clear();
+  for (const int node : data.broad.candidate_nodes) {
     const auto n = static_cast<std::size_t>(node);
-    const bool held = data.hold_stamp[n] == frame.step || data.hold_stamp[n] == frame.step - 1;
+    const bool held = data.displacement.hold_stamp[n] == frame.step || data.displacement.hold_stamp[n] == frame.step - 1;
     if (!held || soft.m_nodes[node].m_im == 0) {
-      if (data.moved_stamp[n] == frame.step) data.moved_stamp[n] = frame.step - 1;
+      if (data.displacement.moved_stamp[n] == frame.step) data.displacement.moved_stamp[n] = frame.step - 1;
       continue;
     }
     const Eigen::Vector3d p = to_tool(frame, soft.m_nodes[node].m_x);
-    data.end_tool_m[n] = p;
-    const ToolPlane& plane = planes[static_cast<std::size_t>(data.hold_plane[n])];
+    data.broad.end_tool_m[n] = p;
+    const ToolPlane& plane = planes[static_cast<std::size_t>(data.displacement.hold_plane[n])];
     const double gap_m = plane.normal_tool.dot(p) - plane.offset_m;
     if (gap_m > release_m || gap_m < -kInsideTolerance_m) {
       // Lifted off beyond the release band, or left behind the plane beside the tool: released.
-      if (data.hold_stamp[n] == frame.step) data.hold_stamp[n] = frame.step - 2;
-      if (data.moved_stamp[n] == frame.step) data.moved_stamp[n] = frame.step - 1;
+      if (data.displacement.hold_stamp[n] == frame.step) data.displacement.hold_stamp[n] = frame.step - 2;
+      if (data.displacement.moved_stamp[n] == frame.step) data.displacement.moved_stamp[n] = frame.step - 1;
       continue;
     }
-    data.node_share[n] = release_share(gap_m, release_m);
-    data.friction_anchor_tool_m[n] = p;
-    data.friction_anchor_stamp[n] = frame.step;
-    data.hold_stamp[n] = frame.step;
-    data.moved_stamp[n] = frame.step;
-    data.moved_nodes.push_back(node);
+    data.displacement.node_share[n] = release_share(gap_m, release_m);
+    data.solver.friction_anchor_tool_m[n] = p;
+    data.solver.friction_anchor_stamp[n] = frame.step;
+    data.displacement.hold_stamp[n] = frame.step;
+    data.displacement.moved_stamp[n] = frame.step;
+    data.displacement.moved_nodes.push_back(node);
   }
 }
 
