@@ -51,14 +51,21 @@ ToolVolume ToolVolume::from_box(const Eigen::Vector3d& half_extents_m) {
 
 ToolVolume ToolVolume::from_convex_mesh(const std::vector<Eigen::Vector3d>& vertices_m, const std::vector<std::array<int, 3>>& triangles) {
   if (vertices_m.size() < 4 || triangles.size() < 4) throw std::invalid_argument("ToolVolume::from_convex_mesh: too few vertices/triangles");
-  ToolVolume v;
+  std::vector<std::pair<Eigen::Vector3d, double>> planes;
   for (const auto& t : triangles) {
     const Eigen::Vector3d& a = vertices_m.at(static_cast<std::size_t>(t[0]));
     const Eigen::Vector3d n = (vertices_m.at(static_cast<std::size_t>(t[1])) - a).cross(vertices_m.at(static_cast<std::size_t>(t[2])) - a);
     if (n.norm() <= 0.0) continue;
     const Eigen::Vector3d unit = n.normalized();
-    v.planes_.push_back({unit, unit.dot(a)});
+    planes.emplace_back(unit, unit.dot(a));
   }
+  return from_planes(planes, vertices_m);
+}
+
+ToolVolume ToolVolume::from_planes(const std::vector<std::pair<Eigen::Vector3d, double>>& planes, const std::vector<Eigen::Vector3d>& vertices_m) {
+  if (vertices_m.size() < 4 || planes.size() < 4) throw std::invalid_argument("ToolVolume::from_planes: too few vertices/planes");
+  ToolVolume v;
+  for (const auto& [normal, offset_m] : planes) v.planes_.push_back({normal, offset_m});
   std::vector<Eigen::Vector2d> projected;
   double y_lo = std::numeric_limits<double>::infinity(), y_hi = -y_lo;
   for (const Eigen::Vector3d& p : vertices_m) {

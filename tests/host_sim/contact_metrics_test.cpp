@@ -6,6 +6,8 @@
 
 #include <array>
 #include <random>
+#include <stdexcept>
+#include <utility>
 #include <vector>
 
 namespace fissure::host {
@@ -48,6 +50,31 @@ TEST(ToolVolume, ConvexMeshOfABoxAgreesWithTheBox) {
     EXPECT_EQ(mesh.in_footprint(p), box.in_footprint(p));
   }
   EXPECT_NEAR(mesh.half_thickness_m(), 0.002, 1e-15);
+}
+
+// The plate given as its six face planes and eight corners (as a ToolNodes holds it) is the box.
+TEST(ToolVolume, PlanesAndCornersOfABoxAgreeWithTheBox) {
+  std::vector<Eigen::Vector3d> corners;
+  for (int i = 0; i < 8; ++i) {
+    corners.emplace_back((i & 1 ? 1 : -1) * kPlateHalf_m.x(), (i & 2 ? 1 : -1) * kPlateHalf_m.y(), (i & 4 ? 1 : -1) * kPlateHalf_m.z());
+  }
+  std::vector<std::pair<Eigen::Vector3d, double>> planes;
+  for (int axis = 0; axis < 3; ++axis)
+    for (const double sign : {1.0, -1.0}) planes.emplace_back(sign * Eigen::Vector3d::Unit(axis), kPlateHalf_m[axis]);
+  const ToolVolume from_planes = ToolVolume::from_planes(planes, corners);
+  const ToolVolume box = ToolVolume::from_box(kPlateHalf_m);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-0.03, 0.03);
+  std::vector<Eigen::Vector3d> scratch;
+  for (int k = 0; k < 1000; ++k) {
+    const Eigen::Vector3d p(u(rng), u(rng) * 0.2, u(rng));
+    EXPECT_EQ(from_planes.signed_distance_m(p), box.signed_distance_m(p));
+    EXPECT_EQ(from_planes.in_footprint(p), box.in_footprint(p));
+    const Eigen::Vector3d q(u(rng), u(rng) * 0.2, u(rng)), r(u(rng), u(rng) * 0.2, u(rng));
+    EXPECT_EQ(from_planes.reaches_inside(p, q, r, 1e-4, scratch), box.reaches_inside(p, q, r, 1e-4, scratch));
+  }
+  EXPECT_NEAR(from_planes.half_thickness_m(), 0.002, 1e-15);
+  EXPECT_THROW((void)ToolVolume::from_planes({planes.begin(), planes.begin() + 3}, corners), std::invalid_argument);
 }
 
 // A 1 mm blade slicing a coarse triangle between its vertices: every vertex is 10 mm outside,

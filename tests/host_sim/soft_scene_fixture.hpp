@@ -3,6 +3,7 @@
 // 128 faces on a box ground, and a flat soft slab. The tool is NOT a Bullet body here — only the
 // collision under test touches the soft body. Also a crossed-node tracker with the issue-5
 // definition and a plunge driver (kinematic tool, lockstep, 1 ms).
+#include <fissure/host_sim/contact_metrics.hpp>
 #include <fissure/host_sim/thin_body_collision.hpp>
 #include <fissure/host_sim/thin_tool.hpp>
 
@@ -21,9 +22,11 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 namespace fissure::host::test_scene {
@@ -201,34 +204,30 @@ class CrossingTracker {
   double max_penetration_m_ = 0.0;
 };
 
-// How many soft triangles the tool's interior cuts through: each triangle is sampled on a
-// barycentric grid (vertices, edges and interior, `divisions` per edge) and counts when a sample
-// lies deeper than depth_tolerance_m inside the tool volume (tool frame, convex planes). A blade
-// that slices a coarse triangle between its nodes leaves the nodes outside but the triangle's
-// interior inside — the node-based crossing metric cannot see that, this does.
-inline int triangles_cut_by_tool(const ToolNodes& tool, const btSoftBody& soft, const ToolPose& pose,
-                                 double depth_tolerance_m, int divisions = 12, double* deepest_m = nullptr) {
-  int cut = 0;
-  double deepest = 0.0;
-  for (int f = 0; f < soft.m_faces.size(); ++f) {
-    Eigen::Vector3d corner[3];
-    for (int k = 0; k < 3; ++k) {
-      const btVector3& x = soft.m_faces[f].m_n[k]->m_x;
-      corner[k] = pose.to_tool(Eigen::Vector3d(x.x(), x.y(), x.z()));
-    }
-    double face_depth = 0.0;
-    for (int i = 0; i <= divisions; ++i)
-      for (int j = 0; i + j <= divisions; ++j) {
-        const double a = static_cast<double>(i) / divisions;
-        const double b = static_cast<double>(j) / divisions;
-        const Eigen::Vector3d p = corner[0] + a * (corner[1] - corner[0]) + b * (corner[2] - corner[0]);
-        face_depth = std::max(face_depth, -tool.signed_distance_m(p));
-      }
-    deepest = std::max(deepest, face_depth);
-    if (face_depth > depth_tolerance_m) ++cut;
+// How many soft triangles the tool's interior cuts through deeper than depth_tolerance_m: the
+// exact clip of each triangle against the tool's planes (triangles_cut_by_volume, the count
+// HostSimulation reports). A blade that slices a coarse triangle between its nodes leaves the
+// nodes outside but the triangle's interior inside — the node-based crossing metric cannot see
+// that, this does.
+inline int triangles_cut_by_tool(const ToolNodes& tool, const btSoftBody& soft, const ToolPose& pose, double depth_tolerance_m) {
+  std::vector<std::pair<Eigen::Vector3d, double>> planes;
+  for (const ToolPlane& plane : tool.planes()) planes.emplace_back(plane.normal_tool, plane.offset_m);
+  const ToolVolume volume = ToolVolume::from_planes(planes, tool.hull_vertices_tool_m());
+  std::vector<Eigen::Vector3d> nodes_world_m;
+  for (int i = 0; i < soft.m_nodes.size(); ++i) {
+    const btVector3& x = soft.m_nodes[i].m_x;
+    nodes_world_m.emplace_back(x.x(), x.y(), x.z());
   }
-  if (deepest_m != nullptr) *deepest_m = deepest;
-  return cut;
+  std::vector<std::array<int, 3>> faces;
+  for (int f = 0; f < soft.m_faces.size(); ++f) {
+    std::array<int, 3> face{};
+    for (int k = 0; k < 3; ++k) face[static_cast<std::size_t>(k)] = static_cast<int>(soft.m_faces[f].m_n[k] - &soft.m_nodes[0]);
+    faces.push_back(face);
+  }
+  Eigen::Isometry3d tool_to_world = Eigen::Isometry3d::Identity();
+  tool_to_world.linear() = pose.orientation_world.toRotationMatrix();
+  tool_to_world.translation() = pose.position_world_m;
+  return triangles_cut_by_volume(volume, nodes_world_m, faces, tool_to_world, depth_tolerance_m);
 }
 
 struct PlungeOutcome {
@@ -251,7 +250,6 @@ struct PlungeOutcome {
   double soft_top_start_m = 0.0;     // highest soft node (world y) when the tool starts
   double tool_bottom_end_m = 0.0;    // lowest tool point (world y) at the end of the run
   int triangles_cut_end = -1;        // soft triangles cut by the tool at the end (spec.check_triangles_cut)
-  double deepest_triangle_point_end_m = 0.0;
   int max_triangles_cut = -1;        // ... over every step
 };
 
@@ -318,8 +316,7 @@ inline PlungeOutcome run_sphere_plunge(const ToolNodes& tool, SceneCollisionMeth
     if (s == move_steps) outcome.force_y_at_arrival_n = result.force_on_tool_world_n.y();
     if (s >= move_steps) outcome.max_force_y_at_end_n = std::max(outcome.max_force_y_at_end_n, result.force_on_tool_world_n.y());
     if (spec.check_triangles_cut) {
-      outcome.triangles_cut_end =
-          triangles_cut_by_tool(tool, world.soft(), current, spec.cut_tolerance_m, 12, &outcome.deepest_triangle_point_end_m);
+      outcome.triangles_cut_end = triangles_cut_by_tool(tool, world.soft(), current, spec.cut_tolerance_m);
       outcome.max_triangles_cut = std::max(outcome.max_triangles_cut, outcome.triangles_cut_end);
     }
     previous = current;

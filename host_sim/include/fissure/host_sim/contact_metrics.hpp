@@ -29,6 +29,7 @@
 // * penetration: max(0, −signed distance to the tool volume); the max over nodes.
 #include <array>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -47,6 +48,9 @@ class ToolVolume {
   static ToolVolume from_box(const Eigen::Vector3d& half_extents_m);
   /// A closed convex mesh (outward winding); planes are its triangles' planes.
   static ToolVolume from_convex_mesh(const std::vector<Eigen::Vector3d>& vertices_m, const std::vector<std::array<int, 3>>& triangles);
+  /// A convex tool given by its face planes (outward unit normal, offset: n·p ≤ offset inside) and
+  /// its vertices (for the silhouette and the thickness), e.g. a ToolNodes' planes and hull.
+  static ToolVolume from_planes(const std::vector<std::pair<Eigen::Vector3d, double>>& planes, const std::vector<Eigen::Vector3d>& vertices_m);
 
   /// max over planes of (n·p − d): exact depth (negative) inside, a lower bound outside.
   [[nodiscard]] double signed_distance_m(const Eigen::Vector3d& p_tool) const noexcept;
