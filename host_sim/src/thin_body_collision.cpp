@@ -93,7 +93,7 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision, public SoftContact
     out.seconds_response += seconds_between(t0, t1);
     thin_body::hunt_crossley_force(model_, frame_, soft, data_, out);
     if (in_solver()) thin_body::friction_force_on_tool(model_, frame_, soft, data_, out);
-    out.contacted_triangles = static_cast<int>(data_.sweep.contacted_faces.size());
+    out.contacted_triangles = static_cast<int>(data_.exclusion.contacted_faces.size());
     out.seconds_force = seconds_between(t1, Clock::now());
   }
 

@@ -49,9 +49,9 @@ TEST_F(PairExclusion, MutualPairKeepsTheFaceThatMeetsTheSurfaceHeadOn) {
   EXPECT_EQ(data.exclusion.vector[0], top);
   EXPECT_EQ(data.sweep.node_face[static_cast<std::size_t>(top)], -1) << "excluded: no contact this step";
   EXPECT_EQ(data.sweep.node_age[static_cast<std::size_t>(top)], 0) << "and no side memory for the next";
-  ASSERT_EQ(data.sweep.contacted_faces.size(), 1u);
-  EXPECT_EQ(data.sweep.face_plane[3], tool.plane_of_node()[bottom]);
-  EXPECT_EQ(data.sweep.face_lead_node[3], bottom);
+  ASSERT_EQ(data.exclusion.contacted_faces.size(), 1u);
+  EXPECT_EQ(data.exclusion.face_plane[3], tool.plane_of_node()[bottom]);
+  EXPECT_EQ(data.exclusion.face_lead_node[3], bottom);
 }
 
 TEST_F(PairExclusion, SideMemoryWinsTheNodeThatWasInContactFirstLed) {
@@ -91,7 +91,7 @@ TEST_F(PairExclusion, OneWayPairIsCrossCheckedFromTheNodeItPointsAt) {
   EXPECT_EQ(exclude_infeasible_pairs(model, data), 0);
   ASSERT_EQ(data.exclusion.vector.size(), 1u);
   EXPECT_EQ(data.exclusion.vector[0], j);
-  EXPECT_EQ(data.sweep.face_lead_node[2], i);
+  EXPECT_EQ(data.exclusion.face_lead_node[2], i);
 
   // The other way round (j leads) the exclusion falls on i, found from i's own pair.
   CollisionData reversed;
@@ -125,7 +125,7 @@ TEST_F(PairExclusion, UnpairedToolExcludesNothing) {
   touch(data, 1, 1, 1, -1.0, 0.5);
   exclude_infeasible_pairs(model, data);
   EXPECT_TRUE(data.exclusion.vector.empty());
-  EXPECT_EQ(data.sweep.contacted_faces.size(), 1u);
+  EXPECT_EQ(data.exclusion.contacted_faces.size(), 1u);
 }
 
 }  // namespace

@@ -197,12 +197,12 @@ void allocate_collision_data(const CollisionModel& model, CollisionData& data) {
   data.broad.face_candidate_stamp.assign(soft_faces, -1);
   data.broad.candidate_faces.clear();
   data.broad.candidate_faces.reserve(soft_faces);
-  data.sweep.face_contact_stamp.assign(soft_faces, -1);
+  data.exclusion.face_contact_stamp.assign(soft_faces, -1);
   data.force.face_force_stamp.assign(soft_faces, -1);
-  data.sweep.face_plane.assign(soft_faces, -1);
-  data.sweep.face_lead_node.assign(soft_faces, -1);
-  data.sweep.contacted_faces.clear();
-  data.sweep.contacted_faces.reserve(soft_faces);
+  data.exclusion.face_plane.assign(soft_faces, -1);
+  data.exclusion.face_lead_node.assign(soft_faces, -1);
+  data.exclusion.contacted_faces.clear();
+  data.exclusion.contacted_faces.reserve(soft_faces);
   data.force.hc_stamp.assign(soft_faces, -1);
   data.force.hc_x_prev_m.assign(soft_faces, 0.0);
   data.force.hc_rate_filtered_m_s.assign(soft_faces, 0.0);

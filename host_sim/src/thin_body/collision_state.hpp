@@ -158,16 +158,17 @@ struct NodeSweepData {  // stage 2 (node_sweep.cpp): tool nodes against soft tri
   std::vector<std::uint8_t> plane_open;
   std::vector<std::uint64_t> contact_words;  // bitset over the tool nodes (orders contact_nodes; all 0 between steps)
   int node_tests = 0;  // node tests the last sweep_tool_nodes call ran
-  // Per soft face hit this step: the leading tool node and its plane.
-  std::vector<std::int64_t> face_contact_stamp;
-  std::vector<int> face_plane;
-  std::vector<int> face_lead_node;
-  std::vector<int> contacted_faces;  // stage 2: faces hit by a tool node; stage 4: faces with a colliding soft node
 };
 
 struct PairExclusionData {  // stage 3 (pair_exclusion.cpp)
   std::vector<std::int64_t> node_excluded_stamp;
   std::vector<int> vector;  // the paper's exclusion vector (this step)
+  // Per soft face hit this step by a tool node that survived the exclusion: the leading tool node
+  // and its plane (stage 4 rewrites the plane a face's vertices were placed on).
+  std::vector<std::int64_t> face_contact_stamp;
+  std::vector<int> face_plane;
+  std::vector<int> face_lead_node;
+  std::vector<int> contacted_faces;  // stage 3: faces hit by a tool node; stage 4: faces with a colliding soft node
 };
 
 struct DisplacementData {  // stage 4 (enforced_displacement.cpp; in_solver: solver_projection.cpp)

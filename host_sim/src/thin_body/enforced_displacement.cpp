@@ -117,13 +117,13 @@ struct Writer {
 
   void paired_faces() {
     const double feasible_slack = model.params.contact_distance_m + model.params.skin_m;
-    for (const int face : data.sweep.contacted_faces) {
-      const int plane_index = data.sweep.face_plane[static_cast<std::size_t>(face)];
+    for (const int face : data.exclusion.contacted_faces) {
+      const int plane_index = data.exclusion.face_plane[static_cast<std::size_t>(face)];
       const ToolPlane& plane = model.tool.planes()[static_cast<std::size_t>(plane_index)];
       // Wrapping applies when the rim LEADS into the triangle (its node meets it head-on, as an
       // edge-first blade does); a rim node grazing a triangle at the side of a plate moving
       // face-first must not drag the vertices under the plate sideways onto its rim plane.
-      const int lead = data.sweep.face_lead_node[static_cast<std::size_t>(face)];
+      const int lead = data.exclusion.face_lead_node[static_cast<std::size_t>(face)];
       const bool rim_leads = model.rim_plane[static_cast<std::size_t>(plane_index)] != 0 && lead >= 0 &&
                              data.sweep.node_facing[static_cast<std::size_t>(lead)] < -kRimHeadOnCosine;
       for (const int node : model.soft.face_nodes[static_cast<std::size_t>(face)]) {
@@ -194,7 +194,7 @@ struct Writer {
       const int plane_index = plane_of_node[static_cast<std::size_t>(i)];
       for (const int node : model.soft.face_nodes[static_cast<std::size_t>(face)])
         if (!fixed(node)) place_on_plane(node, plane_index);
-      data.sweep.face_plane[static_cast<std::size_t>(face)] = plane_index;  // last writer, as placed
+      data.exclusion.face_plane[static_cast<std::size_t>(face)] = plane_index;  // last writer, as placed
     }
   }
 };
@@ -267,10 +267,10 @@ void add_force_face(const StepFrame& frame, CollisionData& data, int face, int p
   const auto f = static_cast<std::size_t>(face);
   if (data.force.face_force_stamp[f] == frame.step) return;
   data.force.face_force_stamp[f] = frame.step;
-  const bool hit_on_same_plane = data.sweep.face_contact_stamp[f] == frame.step && data.sweep.face_plane[f] == plane_index;
-  if (!hit_on_same_plane) data.sweep.face_lead_node[f] = -1;
-  data.sweep.face_plane[f] = plane_index;
-  data.sweep.contacted_faces.push_back(face);
+  const bool hit_on_same_plane = data.exclusion.face_contact_stamp[f] == frame.step && data.exclusion.face_plane[f] == plane_index;
+  if (!hit_on_same_plane) data.exclusion.face_lead_node[f] = -1;
+  data.exclusion.face_plane[f] = plane_index;
+  data.exclusion.contacted_faces.push_back(face);
 }
 
 }  // namespace
@@ -279,7 +279,7 @@ void collect_force_faces(const CollisionModel& model, const StepFrame& frame, Co
   // Paper: "the calculation of x is executed if and only if at least one of the nodes belonging to
   // the triangle is in a colliding state" — the force set is every triangle around a colliding
   // soft node (displaced this step, or held within the release distance).
-  data.sweep.contacted_faces.clear();
+  data.exclusion.contacted_faces.clear();
   for (const int node : data.displacement.moved_nodes) {
     const auto n = static_cast<std::size_t>(node);
     for (int k = model.soft.faces_of_node_begin[n]; k < model.soft.faces_of_node_begin[n + 1]; ++k)

@@ -152,10 +152,10 @@ void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, co
   const double alpha = frame.dt_s / (frame.dt_s + time_constant_s);
   const auto& planes = model.tool.planes();
   const bool normal_measure = hc.measure == DeformationMeasure::kNormalDisplacement;
-  for (const int face : data.sweep.contacted_faces) {
+  for (const int face : data.exclusion.contacted_faces) {
     const auto f = static_cast<std::size_t>(face);
     const Eigen::Vector3d c_now = centroid(model.soft, soft, face, false);
-    const int plane_index = data.sweep.face_plane[f];
+    const int plane_index = data.exclusion.face_plane[f];
     const ToolPlane& plane = planes[static_cast<std::size_t>(plane_index)];
     const Eigen::Vector3d normal_world = frame.r_cur * plane.normal_tool;
     const Eigen::Vector3d normal_prev_world = frame.r_prev * plane.normal_tool;
@@ -221,7 +221,7 @@ void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, co
       x_record = x;
       rate_record = rate;
     }
-    add_contact(ContactRecord{face, data.sweep.face_lead_node[f], plane_index, model.params.jaw, c_now, normal_world, x_record, rate_record, weight, force}, out);
+    add_contact(ContactRecord{face, data.exclusion.face_lead_node[f], plane_index, model.params.jaw, c_now, normal_world, x_record, rate_record, weight, force}, out);
   }
   if (model.params.response == ContactResponse::kInSolver) rim_contact_forces(model, frame, soft, data, alpha, out);
 }

@@ -92,20 +92,20 @@ int exclude_infeasible_pairs(const CollisionModel& model, CollisionData& data) {
     if (pair_of[static_cast<std::size_t>(pair)] != i || i < pair) ++both_face;
   }
   // Contacted faces and the plane each is placed on.
-  data.sweep.contacted_faces.clear();
+  data.exclusion.contacted_faces.clear();
   const auto& plane_of_node = model.tool.plane_of_node();
   for (const int i : data.sweep.contact_nodes) {
     const int face = data.sweep.node_face[static_cast<std::size_t>(i)];
     if (face < 0) continue;
     const auto f = static_cast<std::size_t>(face);
-    if (data.sweep.face_contact_stamp[f] != data.step) {
-      data.sweep.face_contact_stamp[f] = data.step;
-      data.sweep.contacted_faces.push_back(face);
-      data.sweep.face_lead_node[f] = i;
-      data.sweep.face_plane[f] = plane_of_node[static_cast<std::size_t>(i)];
-    } else if (model.paired && places_face(model, data, i, data.sweep.face_lead_node[f])) {
-      data.sweep.face_lead_node[f] = i;
-      data.sweep.face_plane[f] = plane_of_node[static_cast<std::size_t>(i)];
+    if (data.exclusion.face_contact_stamp[f] != data.step) {
+      data.exclusion.face_contact_stamp[f] = data.step;
+      data.exclusion.contacted_faces.push_back(face);
+      data.exclusion.face_lead_node[f] = i;
+      data.exclusion.face_plane[f] = plane_of_node[static_cast<std::size_t>(i)];
+    } else if (model.paired && places_face(model, data, i, data.exclusion.face_lead_node[f])) {
+      data.exclusion.face_lead_node[f] = i;
+      data.exclusion.face_plane[f] = plane_of_node[static_cast<std::size_t>(i)];
     }
   }
   return both_face;
