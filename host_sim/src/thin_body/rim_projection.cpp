@@ -30,6 +30,8 @@ namespace fissure::host::thin_body {
 namespace {
 
 constexpr double kMaxLever = 3.0;
+// Up to this many tool planes, testing each as a separating plane costs less than the prism clip.
+constexpr std::size_t kPlanesWorthTesting = 16;
 
 // The segment a → b clipped to the half-spaces m_k·(p − o_k) ≥ 0: false when nothing is left.
 bool clip_to_prism(const std::array<Eigen::Vector3d, 3>& side_normal, const std::array<Eigen::Vector3d, 3>& side_origin,
@@ -110,6 +112,15 @@ bool separated_by_a_held_plane(const CollisionModel& model, const StepFrame& fra
         plane.normal_tool.dot(triangle.x[2]) >= plane.offset_m)
       return true;
   }
+  return false;
+}
+
+// Whether some tool face plane has all three of the triangle's corners on or in front of it.
+bool separated_by_a_tool_plane(const CollisionModel& model, const SoftTriangleInTool& triangle) {
+  for (const ToolPlane& plane : model.tool.planes())
+    if (plane.normal_tool.dot(triangle.x[0]) >= plane.offset_m && plane.normal_tool.dot(triangle.x[1]) >= plane.offset_m &&
+        plane.normal_tool.dot(triangle.x[2]) >= plane.offset_m)
+      return true;
   return false;
 }
 
@@ -247,6 +258,9 @@ int project_rim_contacts(const CollisionModel& model, const StepFrame& frame, bt
     // triangle is not cut. The planes its corners are held on are the ones to try: a triangle
     // pressed flat under a face is the common candidate, and this spares it the prism clip.
     if (separated_by_a_held_plane(model, frame, data, nodes, triangle)) continue;
+    // The same separation by any face plane, where the tool has few (a box has six: cheaper than
+    // the prism clip; a rounded mesh's hundreds are not).
+    if (model.tool.planes().size() <= kPlanesWorthTesting && separated_by_a_tool_plane(model, triangle)) continue;
     // A cut needs the tool on both sides of the triangle's plane: most candidates lie wholly on
     // one side, and the corners say so without the prism clip.
     const ToolHeightRange range = tool_height_range(model, triangle.x[0], triangle.normal);
