@@ -21,4 +21,9 @@ expect_usage_error no-such-subcommand
 expect_usage_error --no-such-option
 expect_usage_error
 expect_usage_error bench no-such-benchmark
+# A value outside an option's choices is refused before anything runs, naming the choices.
+expect_usage_error bench collision --json /dev/null --contact-response sideways
+expect_usage_error bench collision --json /dev/null --in-solver-friction maybe
+out=$("$fissure" bench collision --json /dev/null --in-solver-friction maybe 2>&1)
+grep -q '{on,off}' <<<"$out" || fail "the refusal of --in-solver-friction does not name its choices: $out"
 echo "cli contract holds"
