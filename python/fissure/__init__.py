@@ -16,9 +16,11 @@ the user). Arrays of points are (N, 3) float64; faces are (F, 3) int32.
 
 What is here:
   Scene.load / Scene.from_toml      a scene (errors: SceneError with .file, .line, .field)
-  HostSimulation                    settle, step, contacts, crossed nodes, node arrays
+  HostSimulation                    settle, step (force, per-jaw normal and friction), contacts,
+                                    crossed nodes, node arrays; contact_response 'after_step' / 'in_solver'
   run_session                       a `fissure run` session: trace arrays + summary dict
-  bench_collision, bench_kinematics, bench_pareto, bench_proxy, bench_rt, bench_view,
+  bench_collision, bench_grasp, bench_kinematics, bench_mesh, bench_pareto, bench_proxy,
+  bench_rt, bench_tissue, bench_view,
   hil_latency, stress              the benchmarks / stress harness: the dict their JSON holds
   run_plunge_hold, plunge_tools     one cell of the tunnelling sweep
   fk, ik, jacobian, in_workspace    Falcon kinematics (one point or a batch)
@@ -60,10 +62,13 @@ from ._fissure import (  # noqa: E402  (the environment above must be set first)
 )
 from .evaluation import (  # noqa: E402
     bench_collision,
+    bench_grasp,
     bench_kinematics,
+    bench_mesh,
     bench_pareto,
     bench_proxy,
     bench_rt,
+    bench_tissue,
     bench_view,
     hil_latency,
     stress,
@@ -76,7 +81,8 @@ __all__ = [
     "HostSimulation", "Scene", "StepResult", "ToolPose",
     "fk", "ik", "in_workspace", "jacobian",
     "plunge_scene", "plunge_tools", "run_plunge_hold",
-    "bench_collision", "bench_kinematics", "bench_pareto", "bench_proxy", "bench_rt", "bench_view",
+    "bench_collision", "bench_grasp", "bench_kinematics", "bench_mesh", "bench_pareto", "bench_proxy", "bench_rt",
+    "bench_tissue", "bench_view",
     "hil_latency", "stress", "stress_case_names",
     "SessionResult", "TRACE_COLUMNS", "read_trace", "run_session",
 ]

@@ -9,10 +9,31 @@ from typing import Optional, Sequence
 from . import _fissure
 
 
-def bench_collision(quick: bool = False, full: bool = False, only: Optional[Sequence[str]] = None) -> dict:
-    """`fissure bench collision`: tunnelling sweep, force–indentation, mesh convergence, cost vs mesh.
-    only: parts to run ('sweep', 'indentation', 'scaling'; None: all). quick: CI-sized."""
-    return json.loads(_fissure._bench_collision(quick, full, list(only or [])))
+def bench_collision(quick: bool = False, full: bool = False, only: Optional[Sequence[str]] = None,
+                    contact_response: str = "after_step", in_solver_friction: bool = True) -> dict:
+    """`fissure bench collision`: tunnelling sweep, levering and clamp-release cells, force–indentation,
+    mesh convergence, cost vs mesh. only: parts to run ('sweep', 'cells', 'indentation', 'scaling'; None: all).
+    quick: CI-sized. contact_response: 'after_step' or 'in_solver' (`--contact-response`); in_solver_friction:
+    the in-solver cells' tool friction 0.5 / 0.4 (True) or none (`--in-solver-friction on|off`)."""
+    return json.loads(_fissure._bench_collision(quick, full, list(only or []), contact_response, in_solver_friction))
+
+
+def bench_grasp(quick: bool = False) -> dict:
+    """`fissure bench grasp`: clamp lift with the shipped friction and at mu 0.05, release delay, pull-out force
+    against grip force, and the drag rt_core renders; 'checks' holds each target with its value and bound."""
+    return json.loads(_fissure._bench_grasp(quick))
+
+
+def bench_mesh(quick: bool = False) -> dict:
+    """`fissure bench mesh`: load time of tool meshes (OBJ, STL), soft-body surface meshes and tetrahedral
+    meshes against their size. quick: without the ~362k-triangle rows."""
+    return json.loads(_fissure._bench_mesh(quick))
+
+
+def bench_tissue(quick: bool = False) -> dict:
+    """`fissure bench tissue`: Bullet's FEM against analytic anchors (cube compression, Sneddon punch,
+    cantilever) and the step cost against node count. quick: the two coarser resolutions only."""
+    return json.loads(_fissure._bench_tissue(quick))
 
 
 def bench_kinematics(samples: int = 20000, repeats: int = 5, seed: int = 2024) -> dict:

@@ -44,6 +44,11 @@ inline host::SceneCollisionMethod parse_method(const std::string& name) {
   throw std::invalid_argument("collision method '" + name + "': expected paired, ray or bullet");
 }
 
+inline host::ContactResponse parse_contact_response(const std::string& name) {
+  if (const auto response = host::parse_contact_response(name)) return *response;
+  throw std::invalid_argument("contact response '" + name + "': expected after_step or in_solver");
+}
+
 /// A ToolPose, a position [x, y, z] (keeps orientation_from's orientation) or [x, y, z, qw, qx, qy, qz].
 host::ToolPose tool_pose_from(const pybind11::handle& pose, const host::ToolPose& orientation_from);
 

@@ -14,11 +14,15 @@
 #include <nlohmann/json.hpp>
 
 #include "bindings.hpp"
+#include "conversions.hpp"
 #include "fissure/eval/bench_collision.hpp"
+#include "fissure/eval/bench_grasp.hpp"
 #include "fissure/eval/bench_kinematics.hpp"
+#include "fissure/eval/bench_mesh.hpp"
 #include "fissure/eval/bench_pareto.hpp"
 #include "fissure/eval/bench_proxy.hpp"
 #include "fissure/eval/bench_rt.hpp"
+#include "fissure/eval/bench_tissue.hpp"
 #include "fissure/eval/bench_view.hpp"
 #include "fissure/eval/hil_latency.hpp"
 #include "fissure/eval/stress_cases.hpp"
@@ -45,14 +49,40 @@ std::string json_text(Bench&& bench) {
 void bind_eval(py::module_& m) {
   m.def(
       "_bench_collision",
-      [](bool quick, bool full, const std::vector<std::string>& only) {
+      [](bool quick, bool full, const std::vector<std::string>& only, const std::string& contact_response, bool in_solver_friction) {
         eval::BenchCollisionOptions o;
         o.quick = quick;
         o.full = full;
         o.only = only;
+        o.contact_response = parse_contact_response(contact_response);
+        o.in_solver_tool_friction = in_solver_friction;
         return json_text([&] { return eval::run_bench_collision(o); });
       },
-      py::arg("quick"), py::arg("full"), py::arg("only"));
+      py::arg("quick"), py::arg("full"), py::arg("only"), py::arg("contact_response"), py::arg("in_solver_friction"));
+  m.def(
+      "_bench_grasp",
+      [](bool quick) {
+        eval::BenchGraspOptions o;
+        o.quick = quick;
+        return json_text([&] { return eval::run_bench_grasp(o); });
+      },
+      py::arg("quick"));
+  m.def(
+      "_bench_mesh",
+      [](bool quick) {
+        eval::BenchMeshOptions o;
+        o.quick = quick;
+        return json_text([&] { return eval::run_bench_mesh(o); });
+      },
+      py::arg("quick"));
+  m.def(
+      "_bench_tissue",
+      [](bool quick) {
+        eval::BenchTissueOptions o;
+        o.quick = quick;
+        return json_text([&] { return eval::run_bench_tissue(o); });
+      },
+      py::arg("quick"));
   m.def(
       "_bench_kinematics",
       [](std::size_t samples, int repeats, std::uint64_t seed) {

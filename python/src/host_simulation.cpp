@@ -41,14 +41,28 @@ struct StepResult {
   int cut_triangles = -1;
 };
 
+/// The scene with its contact response overridden, refused as the loader refuses a file that
+/// asks for friction without the in-solver response (friction is solved only there).
+SceneDescription with_contact_response(const SceneDescription& scene, const std::optional<std::string>& name) {
+  SceneDescription out = scene;
+  if (!name) return out;
+  out.simulation.contact_response = parse_contact_response(*name);
+  if (out.tool.friction_static_ratio > 0.0 && out.simulation.contact_response != host::ContactResponse::kInSolver) {
+    throw std::invalid_argument("scene '" + scene.name + "' has tool friction (static " + std::to_string(scene.tool.friction_static_ratio) +
+                                "), which is solved inside the soft-body solver: contact_response must be 'in_solver', not '" + *name + "'");
+  }
+  return out;
+}
+
 class PyHostSimulation {
  public:
-  PyHostSimulation(const SceneDescription& scene, const std::optional<std::string>& method, bool solver_node_bounds) {
+  PyHostSimulation(const SceneDescription& scene, const std::optional<std::string>& method, bool solver_node_bounds,
+                   const std::optional<std::string>& contact_response) {
     std::optional<host::SceneCollisionMethod> parsed;
     if (method) parsed = parse_method(*method);
     host::HostSimulationOptions options;
     options.solver_node_bounds = solver_node_bounds;
-    sim_ = std::make_unique<HostSimulation>(scene, parsed, options);
+    sim_ = std::make_unique<HostSimulation>(with_contact_response(scene, contact_response), parsed, options);
     const btSoftBody& soft = sim_->world().soft();
     const btSoftBody::Node* first = &soft.m_nodes[0];
     faces_.reserve(static_cast<std::size_t>(soft.m_faces.size()) * 3);
@@ -175,6 +189,24 @@ void bind_host(py::module_& m) {
             return to_array(std::move(f), {s.result.part_count, 3});
           },
           "(P, 3) float64: force on each tool part [N, world]; P = 1 (spatula) or 2 (clamp: jaw A at +y, jaw B at −y)")
+      .def_property_readonly(
+          "friction_force",
+          [](const StepResult& s) {
+            Eigen::Vector3d total = Eigen::Vector3d::Zero();
+            for (int p = 0; p < s.result.part_count; ++p) total += s.result.part_results[static_cast<std::size_t>(p)].friction_force_on_tool_world_n;
+            return total;
+          },
+          "(3,) float64: the friction part of `force` [N, world] (0 without tool friction)")
+      .def_property_readonly(
+          "part_friction_forces",
+          [](const StepResult& s) {
+            std::vector<double> f;
+            for (int p = 0; p < s.result.part_count; ++p) {
+              for (int k = 0; k < 3; ++k) f.push_back(s.result.part_results[static_cast<std::size_t>(p)].friction_force_on_tool_world_n[k]);
+            }
+            return to_array(std::move(f), {s.result.part_count, 3});
+          },
+          "(P, 3) float64: the friction part of each part's force [N, world] (clamp: jaw A at +y, jaw B at −y)")
       .def_property_readonly("part_count", [](const StepResult& s) { return s.result.part_count; })
       .def_property_readonly("contact_count", [](const StepResult& s) { return s.result.contact_count; })
       .def_property_readonly("contacts", [](const StepResult& s) { return contacts_dict(s.result); },
@@ -233,10 +265,12 @@ void bind_host(py::module_& m) {
                                "    for i in range(500):               # down at 5 cm/s: 0.05 mm per 1 ms step\n"
                                "        r = sim.step([0.0, 0.12 - 0.05e-3 * i, 0.0])   # tool target [m, world]\n"
                                "    print(r.force, r.crossed_nodes)    # force on the tool [N, world]; 0")
-      .def(py::init<const SceneDescription&, const std::optional<std::string>&, bool>(), py::arg("scene"), py::arg("method") = py::none(),
-           py::arg("solver_node_bounds") = true,
+      .def(py::init<const SceneDescription&, const std::optional<std::string>&, bool, const std::optional<std::string>&>(), py::arg("scene"),
+           py::arg("method") = py::none(), py::arg("solver_node_bounds") = true, py::arg("contact_response") = py::none(),
            "method: 'paired', 'ray' or 'bullet' (None: the scene's). solver_node_bounds=False: Bullet's stock soft\n"
-           "solver (the same simulation bit for bit; the broad phase then reads every node).")
+           "solver (the same simulation bit for bit; the broad phase then reads every node). contact_response:\n"
+           "'after_step' or 'in_solver' (None: the scene's [simulation] contact_response); a scene with tool friction\n"
+           "needs 'in_solver' (ValueError otherwise).")
       .def("settle", &PyHostSimulation::settle, py::arg("seconds"),
            "Lets the soft body settle under gravity with the tool at the trajectory start, takes the settled shape\n"
            "as the Hunt-Crossley rest state (rest_positions()) and restarts the clock at 0. Call once before contact.")
@@ -259,6 +293,9 @@ void bind_host(py::module_& m) {
           "(ToolPose, jaw_gap_m) of the scene's scripted trajectory at the current time.")
       .def_property_readonly("scene", [](const PyHostSimulation& s) { return s.sim().scene(); }, "the Scene (a copy)")
       .def_property_readonly("method", [](const PyHostSimulation& s) { return std::string(host::to_string(s.sim().method())); })
+      .def_property_readonly("contact_response",
+                             [](const PyHostSimulation& s) { return std::string(host::to_string(s.sim().scene().simulation.contact_response)); },
+                             "'after_step' or 'in_solver': where the thin-body response acts (paired / ray)")
       .def_property_readonly("time_s", [](const PyHostSimulation& s) { return s.sim().time_s(); }, "simulated time [s]")
       .def_property_readonly("tool_pose", [](const PyHostSimulation& s) { return s.sim().tool_pose(); }, "the tool's current ToolPose")
       .def_property_readonly("jaw_gap_m", &PyHostSimulation::jaw_gap_m, "clamp: the jaw gap step() keeps when given none [m]; 0 otherwise")

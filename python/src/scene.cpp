@@ -138,6 +138,17 @@ void bind_scene(py::module_& m) {
                              "(3,) gravity [m/s², world]")
       .def_property_readonly("collision_method", [](const SceneDescription& s) { return std::string(host::to_string(s.simulation.collision_method)); },
                              "'paired', 'ray' or 'bullet'")
+      .def_property_readonly("contact_response",
+                             [](const SceneDescription& s) { return std::string(host::to_string(s.simulation.contact_response)); },
+                             "'after_step' (the thin-body response after Bullet's step) or 'in_solver' (inside its position\n"
+                             "iterations, with Bullet's links and anchors); paired / ray only")
+      .def_property_readonly("friction_static_ratio", [](const SceneDescription& s) { return s.tool.friction_static_ratio; },
+                             "tool–tissue Coulomb friction, static (0: frictionless; needs contact_response 'in_solver')")
+      .def_property_readonly("friction_kinetic_ratio", [](const SceneDescription& s) { return s.tool.friction_kinetic_ratio; },
+                             "tool–tissue Coulomb friction, kinetic (≤ the static ratio)")
+      .def_property_readonly("soft_model",
+                             [](const SceneDescription& s) { return std::string(s.soft_body.model == host::SoftBodyModel::kFem ? "fem" : "shell"); },
+                             "'shell' (Bullet's mass-spring soft body) or 'fem' (Bullet's deformable-world FEM, SI material)")
       .def_property_readonly("tool_kind", [](const SceneDescription& s) { return std::string(tool_kind_name(s.tool.kind)); },
                              "'box', 'convex_mesh' or 'clamp'")
       .def_property_readonly("tool_box_size_m", [](const SceneDescription& s) { return vec(s.tool.box_size_m); },

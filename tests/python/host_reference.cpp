@@ -36,7 +36,10 @@ int run_host(const std::string& scene_name, const std::string& method_name, doub
     const HostStepResult& r = sim.step(to_tool_pose(target.pose), target.jaw_gap_m);
     std::printf("step %ld %a %d %d %a\n", i, r.time_s, r.contact_count, r.crossing.crossed_nodes, r.crossing.max_penetration_m);
     print_vector("force", r.force_on_tool_world_n);
-    for (int p = 0; p < r.part_count; ++p) print_vector("part", r.part_force_world_n[static_cast<std::size_t>(p)]);
+    for (int p = 0; p < r.part_count; ++p) {
+      print_vector("part", r.part_force_world_n[static_cast<std::size_t>(p)]);
+      print_vector("friction", r.part_results[static_cast<std::size_t>(p)].friction_force_on_tool_world_n);
+    }
   }
   for (const Eigen::Vector3d& p : sim.node_positions_world_m()) print_vector("node", p);
   return 0;

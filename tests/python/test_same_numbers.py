@@ -22,24 +22,30 @@ def _hex_rows(rows):
     return [[float.fromhex(v) for v in row] for row in rows]
 
 
+# clamp-vessel-lift: the in-solver response with tool friction; by step 1800 the jaws grip and lift.
 @pytest.mark.parametrize("scene_name,method,steps", [("spatula-sphere", "paired", 450), ("clamp-sphere", "paired", 1300),
-                                                     ("spatula-sphere", "bullet", 500)])
+                                                     ("spatula-sphere", "bullet", 500), ("clamp-vessel-lift", "paired", 1800)])
 def test_host_steps_bit_for_bit(host_reference, scene_name, method, steps):
     settle_s = 0.2
     ref = _reference(host_reference, "host", scene_name, method, str(settle_s), str(steps))
     sim = fissure.HostSimulation(fissure.Scene.load(scene_name, check_plausible=False), method=method)
     sim.settle(settle_s)
-    forces, parts, scalars = [], [], []
+    forces, parts, frictions, scalars = [], [], [], []
     for i in range(steps):
         pose, gap = sim.scripted_target()
         r = sim.step(pose, jaw_gap=gap)
         scalars.append([i, r.time_s, r.contact_count, r.crossed_nodes, r.penetration_m])
         forces.append(list(r.force))
         parts.extend(r.part_forces.tolist())
+        frictions.extend(r.part_friction_forces.tolist())
+        np.testing.assert_array_equal(r.friction_force, r.part_friction_forces.sum(axis=0))
     ref_scalars = [[int(s[0]), float.fromhex(s[1]), int(s[2]), int(s[3]), float.fromhex(s[4])] for s in ref["step"]]
     assert scalars == ref_scalars
     assert forces == _hex_rows(ref["force"])
     assert parts == _hex_rows(ref["part"])
+    assert frictions == _hex_rows(ref["friction"])
+    if sim.scene.friction_static_ratio > 0.0:
+        assert max(abs(f[1]) for f in frictions) > 0.1, "the grip must lift by friction to compare it"
     assert sim.node_positions().tolist() == _hex_rows(ref["node"])
     assert max(s[2] for s in scalars) > 0, "the run must reach contact to compare anything"
 
@@ -110,3 +116,21 @@ def test_stress_case_matches_the_command_line(fissure_bin, tmp_path):
     for key in cli_row:
         if key != "wall_s":  # the only wall-clock figure of a lockstep case
             assert py_row[key] == cli_row[key], key
+
+
+def _without_wall_times(value):
+    """The benchmark's JSON without its machine block and wall-clock figures (keys wall_s)."""
+    if isinstance(value, dict):
+        return {k: _without_wall_times(v) for k, v in value.items() if k not in ("machine", "wall_s")}
+    if isinstance(value, list):
+        return [_without_wall_times(v) for v in value]
+    return value
+
+
+def test_grasp_bench_matches_the_command_line(fissure_bin, tmp_path):
+    json_path = tmp_path / "grasp.json"
+    subprocess.run([fissure_bin, "bench", "grasp", "--quick", "--json", str(json_path)], check=True, capture_output=True)
+    cli = json.loads(json_path.read_text())
+    py = fissure.bench_grasp(quick=True)
+    assert _without_wall_times(py) == _without_wall_times(cli)
+    assert {c["name"] for c in py["checks"]} == {c["name"] for c in cli["checks"]} and len(py["checks"]) >= 4
