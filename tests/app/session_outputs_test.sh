@@ -43,6 +43,7 @@ expect_refusal "fell through the ground while settling" sim "$work/coarse.toml" 
 expect_refusal "at most 86400 s" sim spatula-sphere --seconds 1e9
 
 expect_refusal "known scenes: clamp-sphere, clamp-vessel, clamp-vessel-lift, clamp-vessel-retract, convex-spatula-sphere, spatula-ball-drag, spatula-blob, spatula-sphere" run no-such-scene --lockstep
+expect_refusal "looked for $PWD/scenes/no-such-scene.toml" run no-such-scene --lockstep
 expect_refusal "is a directory, not a scene file" run "$work" --lockstep
 
 # Record and replay through the command line: the replayed lockstep trace is the recorded one.
