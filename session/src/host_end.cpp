@@ -130,14 +130,18 @@ HostEndOutcome run_host_end(const HostEndOptions& options) {
   if (established_at_ns >= 0) bridge.close();  // rt_core reports "closed cleanly by the host", not a lost link
   outcome.rt_closed = link.peer_closed;
   outcome.rt_lost = established_at_ns >= 0 && paused_since_ns >= 0 && !link.peer_closed && link.peer_silent;
+  // The pause starts kRtSilentAfter_ns after rt_core's last DeviceState: that is when it went silent.
+  if (outcome.rt_lost) outcome.rt_lost_at_s = std::max(0.0, to_seconds(paused_since_ns - kRtSilentAfter_ns - start_ns));
   outcome.seconds = to_seconds(clock.now() - start_ns);
   outcome.steps = last.steps;
   outcome.late_steps = schedule.late_steps();
   outcome.paused_s = to_seconds(paused_total_ns);
   outcome.interrupted = interrupted(options);
+  char lost_story[96];
+  std::snprintf(lost_story, sizeof lost_story, "established, LOST at %.2f s (rt_core silent from then to the end)", outcome.rt_lost_at_s);
   const std::string link_story = established_at_ns < 0 ? "never established"
                                  : outcome.rt_closed   ? "established, closed cleanly by rt_core"
-                                 : outcome.rt_lost     ? "established, LOST (rt_core silent at the end)"
+                                 : outcome.rt_lost     ? lost_story
                                                        : "established";
   std::printf("fissure host: '%s' %.2f s | link %s | steps %llu (late %llu) | paused %llu× %.2f s | crossed nodes max %d | "
               "host force max %.2f N | discards %llu frames / %llu msgs | rt restarts %llu%s\n",
@@ -150,7 +154,10 @@ HostEndOutcome run_host_end(const HostEndOptions& options) {
   std::fflush(stdout);
   if (established_at_ns < 0) throw SessionError("rt_core at " + options.transport + " never answered: link not established");
   if (outcome.rt_lost) {
-    throw SessionError("link lost: rt_core at " + options.transport + " went silent without closing the link (crashed, killed or cut off)");
+    char at[32];
+    std::snprintf(at, sizeof at, "%.2f s", outcome.rt_lost_at_s);
+    throw SessionError("link lost: rt_core at " + options.transport + " went silent at " + at +
+                       " without closing the link (crashed, killed or cut off)");
   }
   return outcome;
 }

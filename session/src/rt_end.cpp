@@ -35,8 +35,9 @@ bool interrupted(const RtEndOptions& options) {
 }
 
 /// What happened to the link, for the summary line: "never established", "established at 0.31 s,
-/// host live to the end", "established at 0.31 s, host lost at 3.20 s (2 losses)". A host that
-/// stops and one that dies look the same from here: the wire has no goodbye message.
+/// host live at the end", "established at 0.31 s, closed cleanly by the host at 3.20 s", or
+/// "established at 0.31 s, host silent from 3.20 s to the end (2 losses)". A host that stops says
+/// goodbye (the Hello's kHelloClosing flag); one that dies or is cut off just goes silent.
 std::string describe_link(const RtEndOutcome& outcome) {
   if (!outcome.link_established) return "never established";
   char text[160];

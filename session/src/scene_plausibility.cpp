@@ -212,7 +212,13 @@ std::string check_settled_on_ground(const Eigen::AlignedBox3d& loaded_bounds_wor
                            std::to_string(scene.simulation.substeps_count);
   const std::string advice = "use a collision sub-step (time_step_s / substeps_count) of at most " + number(kMaxSettlingSubStep_s) +
                              " s (the shipped ball settles to 95 % of its height at that step)";
-  if (!std::isfinite(lowest_y) || lowest_y < ground_y - tolerance_m) {
+  // Nodes that went NaN or infinite leave the box empty or unbounded (Eigen's extend skips NaN):
+  // its height would print as "-inf %" and its lowest node as "y = -inf m".
+  if (settled_bounds_world_m.isEmpty() || !settled_bounds_world_m.min().allFinite() || !settled_bounds_world_m.max().allFinite()) {
+    throw SessionError("the soft body's node positions became non-finite while settling (" + number(settle_s) + " s, " + step +
+                       "); the scene's values are the usual cause (see docs/scenes.md, \"Plausible values\")");
+  }
+  if (lowest_y < ground_y - tolerance_m) {
     throw SessionError("the soft body fell through the ground while settling (lowest node at y = " + number(lowest_y) + " m after " +
                        number(settle_s) + " s, ground top " + number(ground_y) + " m): " + step + " is too coarse for the fall; " + advice);
   }

@@ -2,7 +2,8 @@
 # What `fissure run` / `fissure sim` leave on disk and say when refused (issue 25): a run refused
 # before it starts (no Falcon, a lockstep rate that does not divide, a duration over a day, a
 # ball that falls through the ground) leaves an earlier run's files byte for byte; a scene name
-# that is no file lists the known scenes and where it looked; a directory is called one.
+# that is no file lists the known scenes and where it looked; a directory is called one; a
+# recording replays bit for bit in lockstep, also one recorded in real time.
 set -u
 fissure=${1:?usage: session_outputs_test.sh <path to fissure>}
 work=$(mktemp -d)
@@ -42,6 +43,7 @@ expect_refusal "fell through the ground while settling" sim "$work/coarse.toml" 
 expect_refusal "at most 86400 s" sim spatula-sphere --seconds 1e9
 
 expect_refusal "known scenes: clamp-sphere, clamp-vessel, clamp-vessel-lift, clamp-vessel-retract, convex-spatula-sphere, spatula-ball-drag, spatula-blob, spatula-sphere" run no-such-scene --lockstep
+expect_refusal "looked for $PWD/scenes/no-such-scene.toml" run no-such-scene --lockstep
 expect_refusal "is a directory, not a scene file" run "$work" --lockstep
 
 # Record and replay through the command line: the replayed lockstep trace is the recorded one.
@@ -51,6 +53,15 @@ replay_out=$("$fissure" run spatula-sphere --lockstep --settle 0.2 --no-plot --q
   --replay "$work/session.frec" 2>&1) || bad "the replay run failed: $replay_out"
 grep -q "0 commands differing from the recorded ones" <<<"$replay_out" || bad "replay summary line: $replay_out"
 cmp -s "$work/rec/trace.csv" "$work/rep/trace.csv" || bad "the replayed trace differs from the recorded one"
+# The lab's workflow: a session recorded in real time (as the USB Falcon is) replays in lockstep
+# the same on every run, whatever the recording run's timing was.
+"$fissure" run spatula-sphere --duration 0.4 --settle 0.2 --no-plot --quiet --out "$work/rt-rec" \
+  --record "$work/realtime.frec" >/dev/null 2>&1 || bad "the real-time recording run failed"
+for i in 1 2; do
+  "$fissure" run spatula-sphere --lockstep --settle 0.2 --no-plot --quiet --out "$work/rt-rep$i" \
+    --replay "$work/realtime.frec" >/dev/null 2>&1 || bad "lockstep replay $i of the real-time recording failed"
+done
+cmp -s "$work/rt-rep1/trace.csv" "$work/rt-rep2/trace.csv" || bad "two lockstep replays of a real-time recording differ"
 head -c 40 "$work/session.frec" >"$work/cut.frec"
 expect_refusal "cut.frec: at byte offset" run spatula-sphere --lockstep --replay "$work/cut.frec" --out "$work/rep"
 expect_refusal "it needs --device sim" run spatula-sphere --device usb --replay "$work/session.frec" --out "$work/rep"

@@ -5,8 +5,9 @@
 # Checks: the host exits 0 having established the link and stepped; the rt end reports the
 # host's clean exit as "closed cleanly by the host" (not "host silent") and, on SIGINT (Ctrl-C),
 # ramps out and exits 0. Then (issue 25) a host killed with SIGKILL: the rt end reports the host
-# silent and exits 1 "link lost"; and an rt on clamp-vessel with a host on spatula-sphere: both
-# refuse the link naming both scenes, exit 1.
+# silent and exits 1 "link lost"; an rt end killed with SIGKILL: the host says when the link was
+# lost and exits 1; and an rt on clamp-vessel with a host on spatula-sphere: both refuse the link
+# naming both scenes, exit 1.
 # Bounded: every wait has a timeout; loopback only.
 set -u
 fissure="$1"
@@ -61,6 +62,27 @@ wait "$rt_pid"; rt2_rc=$?; rt_pid=
 grep -q "host silent" "$log_dir/rt2.err" || { echo "FAIL: rt did not report the killed host silent"; fail=1; }
 grep -q "link lost: the host went silent" "$log_dir/rt2.err" || { echo "FAIL: rt did not say the link was lost"; fail=1; }
 echo "--- killed host: rt stdout"; cat "$log_dir/rt2.out"; echo "--- rt stderr"; tail -5 "$log_dir/rt2.err"
+
+# An rt end that dies: the host says when the link was lost and exits 1.
+port4=$((port + 3)); spec4="udp:127.0.0.1:${port4}"
+"$fissure" host spatula-sphere --transport "$spec4" --seconds 60 --settle 0.2 --connect-timeout 20 --quiet \
+  >"$log_dir/host4.out" 2>"$log_dir/host4.err" &
+host_pid=$!
+"$fissure" rt --transport "$spec4" --scene spatula-sphere --seconds 60 --quiet >"$log_dir/rt4.out" 2>"$log_dir/rt4.err" &
+rt_pid=$!
+for _ in $(seq 1 300); do grep -q "link established" "$log_dir/host4.err" && break; sleep 0.1; done
+sleep 0.5
+kill -KILL "$rt_pid"; wait "$rt_pid" 2>/dev/null; rt_pid=
+sleep 1
+kill -INT "$host_pid"
+for _ in $(seq 1 100); do kill -0 "$host_pid" 2>/dev/null || break; sleep 0.1; done
+wait "$host_pid"; host4_rc=$?
+[ "$host4_rc" -eq 1 ] || { echo "FAIL: after rt was killed fissure host exited $host4_rc, want 1"; fail=1; }
+grep -Eq "link established, LOST at [0-9]+\.[0-9]+ s" "$log_dir/host4.out" ||
+  { echo "FAIL: the host summary does not say when the link was lost"; fail=1; }
+grep -Eq "link lost: rt_core at .* went silent at [0-9]+\.[0-9]+ s" "$log_dir/host4.err" ||
+  { echo "FAIL: the host did not say the link was lost, and when"; fail=1; }
+echo "--- killed rt: host stdout"; cat "$log_dir/host4.out"; echo "--- host stderr"; tail -2 "$log_dir/host4.err"
 
 # Mismatched scenes: refused at both ends, both scenes named.
 port3=$((port + 2)); spec3="udp:127.0.0.1:${port3}"

@@ -8,11 +8,13 @@
 
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <variant>
 
 #include "fissure/host_sim/scene_loader.hpp"
+#include "fissure/session/session_error.hpp"
 
 namespace fissure::session {
 namespace {
@@ -106,6 +108,26 @@ TEST(ScenePlausibility, TheRefusalIsOneLineWithFileLineFieldValueAndRange) {
         << what;
   }
   std::filesystem::remove(file);
+}
+
+TEST(ScenePlausibility, ABodyWhoseNodesWentNonFiniteWhileSettlingIsRefusedWithoutPrintingInf) {
+  // A 1000 km ball: every node NaN or infinite after settling. Its box printed as "settled to
+  // -inf % of its height" before the run's own non-finite refusal.
+  const host::SceneDescription scene = spatula_sphere();
+  const Eigen::AlignedBox3d loaded(Eigen::Vector3d(-0.05, 0.0, -0.05), Eigen::Vector3d(0.05, 0.1, 0.05));
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const Eigen::AlignedBox3d& settled :
+       {Eigen::AlignedBox3d(), Eigen::AlignedBox3d(Eigen::Vector3d(-0.05, -inf, -0.05), Eigen::Vector3d(0.05, 0.1, 0.05))}) {
+    try {
+      (void)check_settled_on_ground(loaded, settled, scene, 1.0);
+      ADD_FAILURE() << "non-finite node positions were accepted";
+    } catch (const SessionError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("node positions became non-finite while settling"), std::string::npos) << what;
+      EXPECT_NE(what.find("simulation.time_step_s"), std::string::npos) << what;
+      EXPECT_EQ(what.find("inf"), std::string::npos) << what;
+    }
+  }
 }
 
 }  // namespace

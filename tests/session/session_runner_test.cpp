@@ -116,6 +116,10 @@ TEST_F(SessionRunnerTest, NonFiniteFiguresFailTheRunNamingTheQuantityAndWriteNot
   std::get<host::SoftSphere>(options_.scene.soft_body.shape).radius_m = 1e6;
   const std::string error = refusal();
   EXPECT_NE(error.find("non-finite"), std::string::npos) << error;
+  // The quantity and when: the nodes while settling, or a trace quantity at its tick.
+  EXPECT_TRUE(error.find("node positions became non-finite while settling") != std::string::npos ||
+              error.find("(tick ") != std::string::npos)
+      << "the quantity is not named: " << error;
   expect_earlier_outputs_untouched();
 }
 

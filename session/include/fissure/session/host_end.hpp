@@ -34,6 +34,7 @@ struct HostEndOutcome {
   double host_force_max_n = 0.0;
   bool rt_closed = false;  ///< rt_core said goodbye (it stopped cleanly)
   bool rt_lost = false;    ///< rt_core silent at the end without a goodbye (crash, kill, cut link)
+  double rt_lost_at_s = -1.0;  ///< when rt_core went silent for good [s from the host's start] (rt_lost only)
   bool interrupted = false;
 };
 
