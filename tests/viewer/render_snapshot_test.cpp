@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <memory>
 #include <vector>
@@ -37,36 +39,88 @@ TEST(RenderModel, MatchesTheSettledSimulation) {
   EXPECT_FALSE(model.has_handle);
 }
 
+std::vector<Eigen::Vector3f> node_positions(const host::HostSimulation& sim) {
+  std::vector<Eigen::Vector3f> nodes;
+  for (const Eigen::Vector3d& p : sim.node_positions_world_m()) nodes.push_back(p.cast<float>());
+  return nodes;
+}
+
+// The colour of every node, sorted, with the body's rigid motion fitted to `nodes` taken out.
+std::vector<float> sorted_fractions(const RenderModel& model, const std::vector<Eigen::Vector3f>& nodes) {
+  const RigidMotion motion = fit_rigid_motion(model, nodes.data(), nodes.size());
+  std::vector<float> fractions;
+  for (std::size_t i = 0; i < nodes.size(); ++i) fractions.push_back(deformation_fraction(model, motion, i, nodes[i]));
+  std::sort(fractions.begin(), fractions.end());
+  return fractions;
+}
+
+// Presses the tool down at 0.1 m/s from its start pose until the body is dented 3 mm: some node
+// 3 mm from where the body's rigid motion carries its settled position.
+void press_a_three_millimetre_dent(const RenderModel& model, host::HostSimulation& sim) {
+  host::ToolPose pose = host::to_tool_pose(sim.scene().trajectory.start);
+  const auto dent_m = [&] { return sorted_fractions(model, node_positions(sim)).back() * model.deformation_full_scale_m; };
+  for (int step = 0; step < 1000 && dent_m() < 0.003F; ++step) {
+    pose.position_world_m.y() -= 0.0001;  // 0.1 m/s at the 1 kHz host step
+    (void)sim.step(pose);
+  }
+  ASSERT_GE(dent_m(), 0.003F);
+  ASSERT_GT(sim.last().contact_count, 0);
+}
+
 TEST(RenderModel, AThreeMillimetreDentIsTheStoryNotTheWholeBallsSag) {
   // The case: the colour scale must show a 3 mm dent, not make the whole ball's motion
   // the story.
   host::HostSimulation sim(scene_named("spatula-sphere"));
   sim.settle(1.0);
   const RenderModel model = make_render_model(sim);
-  host::ToolPose pose = host::to_tool_pose(sim.scene().trajectory.start);
-  const auto max_displacement_m = [&] {
-    float max = 0.0F;
-    for (std::size_t i = 0; i < model.soft_rest_world_m.size(); ++i) {
-      max = std::max(max, (sim.node_positions_world_m()[i].cast<float>() - model.soft_rest_world_m[i]).norm());
-    }
-    return max;
-  };
-  for (int step = 0; step < 400 && max_displacement_m() < 0.003F; ++step) {
-    pose.position_world_m.y() -= 0.0001;  // 0.1 m/s at the 1 kHz host step
-    (void)sim.step(pose);
-  }
-  ASSERT_GE(max_displacement_m(), 0.003F);
-  std::vector<float> fractions;
-  for (std::size_t i = 0; i < model.soft_rest_world_m.size(); ++i) {
-    fractions.push_back(deformation_fraction(model, i, sim.node_positions_world_m()[i].cast<float>()));
-  }
-  std::sort(fractions.begin(), fractions.end());
+  press_a_three_millimetre_dent(model, sim);
+  const std::vector<float> fractions = sorted_fractions(model, node_positions(sim));
   EXPECT_GE(fractions.back(), 0.45F) << "a 3 mm dent must read about half-way to red (full scale "
                                      << model.deformation_full_scale_m * 1e3F << " mm)";
-  // Pressing the top squashes and pushes the whole ball (the median node moves ~1.2 mm): the dent
-  // must still read at least twice as red as the median node.
-  EXPECT_GE(fractions.back(), 2.0F * fractions[fractions.size() / 2]) << "median " << fractions[fractions.size() / 2];
+  // Pressing the top squashes and pushes the whole ball; with its rigid motion out, the rest of the
+  // ball stays blue: the median node reads under a tenth of the dent.
+  EXPECT_GE(fractions.back(), 10.0F * fractions[fractions.size() / 2]) << "median " << fractions[fractions.size() / 2];
   EXPECT_LE(model.deformation_full_scale_m, 0.0066F);
+}
+
+TEST(RenderModel, ABallThatSlidesAndTurnsAsAWholeStaysBlueAndItsDentStillReads) {
+  // The settled paper ball does not stay put on Bullet's ground: untouched it slides a few mm a
+  // second and turns about the vertical (docs/decisions.md, "Contact inside the solver",
+  // 2026-12-06 evening). Two seconds of that, then the press.
+  host::HostSimulation sim(scene_named("spatula-sphere"));
+  sim.settle(1.0);
+  const RenderModel model = make_render_model(sim);
+  const host::ToolPose start = host::to_tool_pose(sim.scene().trajectory.start);
+  for (int step = 0; step < 2000; ++step) (void)sim.step(start);
+  ASSERT_EQ(sim.last().contact_count, 0);
+  std::vector<Eigen::Vector3f> drifted = node_positions(sim);
+  float drift_m = 0.0F;
+  for (std::size_t i = 0; i < drifted.size(); ++i) drift_m = std::max(drift_m, (drifted[i] - model.soft_rest_world_m[i]).norm());
+  ASSERT_GT(drift_m, 0.003F) << "the case needs a body that moved as much as the dent";
+  EXPECT_LE(sorted_fractions(model, drifted).back(), 0.15F) << "untouched, nothing is deformed (it moved " << drift_m * 1e3F << " mm)";
+  press_a_three_millimetre_dent(model, sim);
+  const std::vector<float> fractions = sorted_fractions(model, node_positions(sim));
+  EXPECT_GE(fractions.back(), 0.45F);
+  EXPECT_GE(fractions.back(), 10.0F * fractions[fractions.size() / 2]) << "median " << fractions[fractions.size() / 2];
+}
+
+TEST(RenderModel, TheRigidMotionFitTakesOutATurnAndAShiftExactly) {
+  host::HostSimulation sim(scene_named("spatula-sphere"));
+  sim.settle(0.05);
+  const RenderModel model = make_render_model(sim);
+  const Eigen::Matrix3f turn = Eigen::AngleAxisf(0.35F, Eigen::Vector3f(0.3F, 0.9F, -0.2F).normalized()).toRotationMatrix();
+  const Eigen::Vector3f shift(0.05F, -0.01F, 0.02F);
+  std::vector<Eigen::Vector3f> moved;
+  for (const Eigen::Vector3f& p : model.soft_rest_world_m) moved.push_back(turn * p + shift);
+  const RigidMotion motion = fit_rigid_motion(model, moved.data(), moved.size());
+  EXPECT_TRUE(motion.rotation.isApprox(turn, 1e-4F));
+  EXPECT_TRUE(motion.translation.isApprox(shift, 1e-4F));
+  EXPECT_LE(sorted_fractions(model, moved).back(), 1e-3F);
+  // One node pushed 3 mm further in reads 3 mm on the scale; the fit hardly moves for it.
+  moved[0] -= 0.003F * (moved[0] - motion.translation).normalized();
+  const RigidMotion dented = fit_rigid_motion(model, moved.data(), moved.size());
+  const float node0 = deformation_fraction(model, dented, 0, moved[0]);
+  EXPECT_NEAR(node0 * model.deformation_full_scale_m, 0.003F, 0.0003F);
 }
 
 TEST(RenderModel, ClampHasTwoJawsAndAHandle) {

@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <Eigen/SVD>
+
 #include <BulletSoftBody/btSoftBody.h>
 
 #include "fissure/host_sim/soft_world.hpp"
@@ -88,9 +90,35 @@ RenderModel make_render_model(host::HostSimulation& sim) {
   return model;
 }
 
-float deformation_fraction(const RenderModel& model, std::size_t node, const Eigen::Vector3f& p_world_m) noexcept {
+RigidMotion fit_rigid_motion(const RenderModel& model, const Eigen::Vector3f* nodes_world_m, std::size_t count) noexcept {
+  RigidMotion motion;
+  const std::size_t n = std::min(count, model.soft_rest_world_m.size());
+  if (n < 3) return motion;
+  Eigen::Vector3d rest_centre = Eigen::Vector3d::Zero(), centre = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < n; ++i) {
+    rest_centre += model.soft_rest_world_m[i].cast<double>();
+    centre += nodes_world_m[i].cast<double>();
+  }
+  rest_centre /= static_cast<double>(n);
+  centre /= static_cast<double>(n);
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (std::size_t i = 0; i < n; ++i) {
+    covariance += (nodes_world_m[i].cast<double>() - centre) * (model.soft_rest_world_m[i].cast<double>() - rest_centre).transpose();
+  }
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(covariance, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  // The nearest proper rotation: a reflection would turn the body inside out.
+  Eigen::Matrix3d sign = Eigen::Matrix3d::Identity();
+  sign(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
+  const Eigen::Matrix3d rotation = svd.matrixU() * sign * svd.matrixV().transpose();
+  motion.rotation = rotation.cast<float>();
+  motion.translation = (centre - rotation * rest_centre).cast<float>();
+  return motion;
+}
+
+float deformation_fraction(const RenderModel& model, const RigidMotion& motion, std::size_t node, const Eigen::Vector3f& p_world_m) noexcept {
   if (node >= model.soft_rest_world_m.size()) return 0.0F;
-  return std::clamp((p_world_m - model.soft_rest_world_m[node]).norm() / model.deformation_full_scale_m, 0.0F, 1.0F);
+  const Eigen::Vector3f carried = motion.rotation * model.soft_rest_world_m[node] + motion.translation;
+  return std::clamp((p_world_m - carried).norm() / model.deformation_full_scale_m, 0.0F, 1.0F);
 }
 
 void capture_snapshot(const host::HostSimulation& sim, RenderSnapshot& out) noexcept {

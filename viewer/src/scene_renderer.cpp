@@ -203,13 +203,14 @@ void SceneRenderer::add_soft_body(const RenderSnapshot& snapshot) {
     const Eigen::Vector3f face = (soft_positions_[static_cast<std::size_t>(tri[1])] - a).cross(soft_positions_[static_cast<std::size_t>(tri[2])] - a);
     for (int k = 0; k < 3; ++k) soft_normals_[static_cast<std::size_t>(tri[static_cast<std::size_t>(k)])] += face;
   }
+  const RigidMotion motion = fit_rigid_motion(model_, soft_positions_.data(), static_cast<std::size_t>(n));
   for (const auto& tri : model_.soft_triangles) {
     if (tri[0] >= n || tri[1] >= n || tri[2] >= n) continue;
     for (int k = 0; k < 3; ++k) {
       const auto i = static_cast<std::size_t>(tri[static_cast<std::size_t>(k)]);
       const Eigen::Vector3f& p = soft_positions_[i];
       const Eigen::Vector3f normal = soft_normals_[i].normalized();
-      const float t = deformation_fraction(model_, i, p);
+      const float t = deformation_fraction(model_, motion, i, p);
       float colour[3];
       for (int c = 0; c < 3; ++c) colour[c] = (1.0F - t) * palette::kSoftAtRest[c] + t * palette::kSoftFullyDeformed[c];
       scene_vertices_.insert(scene_vertices_.end(), {p.x(), p.y(), p.z(), normal.x(), normal.y(), normal.z(), colour[0], colour[1], colour[2]});
@@ -300,7 +301,7 @@ std::vector<std::string> SceneRenderer::overlay_lines(const RenderModel& model, 
   std::snprintf(line3, sizeof line3, "CROSSED %d | CONTACTS %d | PATCHES %d | STEP %.2f MS", o.crossed_nodes, o.contacts, snapshot.patch_count,
                 o.host_step_ms);
   char line4[96];
-  std::snprintf(line4, sizeof line4, "COLOUR: DISPLACEMENT FROM SETTLED 0 (BLUE) - %.1f MM (RED)", model.deformation_full_scale_m * 1e3);
+  std::snprintf(line4, sizeof line4, "COLOUR: DEFORMATION (RIGID MOTION TAKEN OUT) 0 (BLUE) - %.1f MM (RED)", model.deformation_full_scale_m * 1e3);
   return {line1, line2, line3, line4};
 }
 

@@ -84,8 +84,8 @@ struct RenderModel {
   std::string scene_name;
   std::vector<std::array<int, 3>> soft_triangles;  ///< indices into the snapshot's nodes (CCW from outside)
   std::vector<Eigen::Vector3f> soft_rest_world_m;  ///< the settled shape: displacement from it is coloured
-  /// Displacement from the settled shape drawn fully red [m]: 0.12 of the soft body's smallest
-  /// half-size (≈ 6 mm for the paper's 5 cm sphere: a 3 mm dent reads half-way to red, over
+  /// Displacement from the settled shape (its rigid motion taken out) drawn fully red [m]: 0.12
+  /// of the soft body's smallest half-size (≈ 6 mm for the paper's 5 cm sphere: a 3 mm dent reads half-way to red, over
   /// twice as red as the rest of the ball, which the press squashes and pushes by ~1 mm; deeper
   /// presses saturate in the dent and the red area shows its extent). Plain displacement, not
   /// strain: Bullet's kLST = 1 links hardly stretch, the body bends instead.
@@ -101,9 +101,24 @@ struct RenderModel {
   float force_arrow_m_per_n = 0.0025F;
 };
 
-/// Where soft node `node`, now at `p_world_m`, sits on the deformation colour map: 0 at its
-/// settled position (blue) → 1 at deformation_full_scale_m or more (red).
-[[nodiscard]] float deformation_fraction(const RenderModel& model, std::size_t node, const Eigen::Vector3f& p_world_m) noexcept;
+/// The rigid motion that carries the settled shape closest to the current nodes (least squares
+/// over the nodes, Kabsch): p ≈ rotation · rest + translation.
+struct RigidMotion {
+  Eigen::Matrix3f rotation = Eigen::Matrix3f::Identity();
+  Eigen::Vector3f translation = Eigen::Vector3f::Zero();
+};
+
+/// Fits the body's rigid motion from its settled shape to `nodes_world_m` (the first
+/// min(count, rest nodes) nodes). The colour map takes it out: a body that slides or turns as a
+/// whole is not deformed, and over a session a free body's drift (centimetres) would otherwise
+/// outgrow the millimetre scale of a dent.
+[[nodiscard]] RigidMotion fit_rigid_motion(const RenderModel& model, const Eigen::Vector3f* nodes_world_m, std::size_t count) noexcept;
+
+/// Where soft node `node`, now at `p_world_m`, sits on the deformation colour map: 0 where the
+/// body's rigid motion carries its settled position (blue) → 1 at deformation_full_scale_m or
+/// more from there (red).
+[[nodiscard]] float deformation_fraction(const RenderModel& model, const RigidMotion& motion, std::size_t node,
+                                         const Eigen::Vector3f& p_world_m) noexcept;
 
 /// Builds the picture's model from a simulation whose soft body has settled (its current node
 /// positions become the rest shape). Throws std::invalid_argument when the soft body has more
