@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -28,6 +29,7 @@
 #include "fissure/eval/sim_report.hpp"
 #include "fissure/session/output_staging.hpp"
 #include "fissure/session/scene_plausibility.hpp"
+#include "fissure/session/session_record.hpp"
 
 namespace fissure::app {
 using namespace fissure::eval;  // sim_quantile, SimProgress, sim_machine_info
@@ -95,15 +97,17 @@ std::optional<host::SceneCollisionMethod> parse_method(const std::string& name) 
   throw CLI::ValidationError("--method", "must be paired, ray or bullet (got '" + name + "')");
 }
 
-/// Step times kept for the timing quantiles: the first 2^20 steps (17 min at 1 kHz); a longer
-/// run's timing figures describe its first 2^20 steps.
-constexpr std::size_t kExactSteps = std::size_t{1} << 20;
 /// The longest run `fissure sim` accepts [s]: a day of simulated time.
 constexpr double kMaxSimSeconds = 86400.0;
 
-/// What a headless run accumulates over its steps.
+/// What a headless run accumulates over its steps, in bounded memory whatever its length (a day
+/// at 1 kHz is 86.4 M steps): the per-step samples behind the quantiles and the force spread are
+/// session::SampleReservoir's, every value up to 2^20 steps (exact) and a uniform sample of the
+/// whole run beyond; the maxima, the mean and the counts are over every step.
 struct SimFigures {
-  std::vector<double> step_s, collision_s, force_in_contact;
+  session::SampleReservoir step_s, collision_s, force_in_contact;
+  /// Sum of |F| over the steps in contact, added in step order (the mean is exact at any length).
+  double force_in_contact_sum = 0.0;
   int crossed_max = 0, contacts_max = 0, wrong_side_max = 0, inside_max = 0;
   double penetration_max = 0.0, force_max = 0.0;
   bool finite = true;
@@ -111,10 +115,8 @@ struct SimFigures {
   std::string first_non_finite;
 
   void add(const host::HostStepResult& r, const Eigen::Vector3d& tool_position_world_m) {
-    if (step_s.size() < kExactSteps) {
-      step_s.push_back(r.times.total_s);
-      collision_s.push_back(r.times.collision_s);
-    }
+    step_s.add(r.times.total_s);
+    collision_s.add(r.times.collision_s);
     const double f = r.force_on_tool_world_n.norm();
     const char* bad = !std::isfinite(f)                                   ? "force on the tool (force_*_n)"
                       : !tool_position_world_m.allFinite()                 ? "tool position (tool_*_m)"
@@ -128,23 +130,28 @@ struct SimFigures {
     }
     finite = finite && bad == nullptr;
     force_max = std::max(force_max, f);
-    if (r.contact_count > 0) force_in_contact.push_back(f);
+    if (r.contact_count > 0) {
+      force_in_contact.add(f);
+      force_in_contact_sum += f;
+    }
     crossed_max = std::max(crossed_max, r.crossing.crossed_nodes);
     wrong_side_max = std::max(wrong_side_max, r.crossing.wrong_side_nodes);
     inside_max = std::max(inside_max, r.crossing.inside_nodes);
     contacts_max = std::max(contacts_max, r.contact_count);
     penetration_max = std::max(penetration_max, r.crossing.max_penetration_m);
   }
+  [[nodiscard]] std::uint64_t steps_in_contact() const noexcept { return force_in_contact.count(); }
   [[nodiscard]] double mean_in_contact() const {
-    double mean = 0.0;
-    for (double f : force_in_contact) mean += f;
-    return force_in_contact.empty() ? 0.0 : mean / static_cast<double>(force_in_contact.size());
+    return steps_in_contact() == 0 ? 0.0 : force_in_contact_sum / static_cast<double>(steps_in_contact());
   }
+  /// Sample standard deviation about the exact mean, over the reservoir's values (all of them
+  /// below 2^20 steps in contact).
   [[nodiscard]] double std_in_contact() const {
     const double mean = mean_in_contact();
+    const std::vector<double>& values = force_in_contact.values();
     double var = 0.0;
-    for (double f : force_in_contact) var += (f - mean) * (f - mean);
-    return force_in_contact.size() > 1 ? std::sqrt(var / static_cast<double>(force_in_contact.size() - 1)) : 0.0;
+    for (double f : values) var += (f - mean) * (f - mean);
+    return values.size() > 1 ? std::sqrt(var / static_cast<double>(values.size() - 1)) : 0.0;
   }
 };
 
@@ -190,7 +197,7 @@ std::unique_ptr<viewer::SessionView> start_frames(const SimOptions& options, hos
   vo.frame_width_px = options.width_px;
   vo.frame_height_px = options.height_px;
   vo.wait_for_frames = true;
-  vo.expected_host_steps = std::min(static_cast<std::size_t>(steps), kExactSteps);
+  vo.expected_host_steps = std::min(static_cast<std::size_t>(steps), session::SampleReservoir::kCapacity);
   std::string error, notice;
   std::unique_ptr<viewer::SessionView> view;
   try {
@@ -206,9 +213,9 @@ void print_summary(const SimFigures& f) {
   std::printf("crossed nodes max %d (wrong side %d, inside %d), max penetration %.4f mm, contacts max %d\n", f.crossed_max,
               f.wrong_side_max, f.inside_max, f.penetration_max * 1e3, f.contacts_max);
   std::printf("force |F| max %.4f N, mean in contact %.4f N (std %.4f N, %zu steps), finite %s\n", f.force_max, f.mean_in_contact(),
-              f.std_in_contact(), f.force_in_contact.size(), f.finite ? "yes" : "NO");
-  std::printf("step time median %.1f us, p99 %.1f us; collision median %.1f us, p99 %.1f us\n", sim_quantile(f.step_s, 0.5) * 1e6,
-              sim_quantile(f.step_s, 0.99) * 1e6, sim_quantile(f.collision_s, 0.5) * 1e6, sim_quantile(f.collision_s, 0.99) * 1e6);
+              f.std_in_contact(), static_cast<std::size_t>(f.steps_in_contact()), f.finite ? "yes" : "NO");
+  std::printf("step time median %.1f us, p99 %.1f us; collision median %.1f us, p99 %.1f us\n", sim_quantile(f.step_s.values(), 0.5) * 1e6,
+              sim_quantile(f.step_s.values(), 0.99) * 1e6, sim_quantile(f.collision_s.values(), 0.5) * 1e6, sim_quantile(f.collision_s.values(), 0.99) * 1e6);
 }
 
 void write_json(const SimOptions& options, const std::filesystem::path& path, const host::SceneDescription& scene,
@@ -228,9 +235,9 @@ void write_json(const SimOptions& options, const std::filesystem::path& path, co
   j["max_penetration_m"] = f.penetration_max;
   j["contacts_max"] = f.contacts_max;
   j["force"] = {{"max_n", f.force_max}, {"mean_in_contact_n", f.mean_in_contact()}, {"std_in_contact_n", f.std_in_contact()},
-                {"steps_in_contact", f.force_in_contact.size()}, {"all_finite", f.finite}};
-  j["step_time_us"] = {{"median", sim_quantile(f.step_s, 0.5) * 1e6}, {"p99", sim_quantile(f.step_s, 0.99) * 1e6}};
-  j["collision_time_us"] = {{"median", sim_quantile(f.collision_s, 0.5) * 1e6}, {"p99", sim_quantile(f.collision_s, 0.99) * 1e6}};
+                {"steps_in_contact", f.steps_in_contact()}, {"all_finite", f.finite}};
+  j["step_time_us"] = {{"median", sim_quantile(f.step_s.values(), 0.5) * 1e6}, {"p99", sim_quantile(f.step_s.values(), 0.99) * 1e6}};
+  j["collision_time_us"] = {{"median", sim_quantile(f.collision_s.values(), 0.5) * 1e6}, {"p99", sim_quantile(f.collision_s.values(), 0.99) * 1e6}};
   if (frames) {
     j["frames"] = {{"dir", options.frames_dir}, {"every_steps", options.frame_every}, {"written", frames->frames_written},
                    {"dropped", frames->frames_dropped}, {"frame_ms_median", sim_quantile(frames->frame_s, 0.5) * 1e3}};
@@ -291,8 +298,6 @@ void run_sim(const SimOptions& options) {
               host::to_string(sim->method()), sim->soft_face_count(), sim->soft_node_count(), steps, dt * 1e3);
   SimProgress progress("sim " + scene.name, steps);
   SimFigures figures;
-  figures.step_s.reserve(std::min(static_cast<std::size_t>(steps), kExactSteps));
-  figures.collision_s.reserve(std::min(static_cast<std::size_t>(steps), kExactSteps));
   for (long i = 0; i < steps; ++i) {
     const host::TrajectorySample target = sim->scripted_target();
     const host::HostStepResult& r = sim->step(host::to_tool_pose(target.pose), target.jaw_gap_m);

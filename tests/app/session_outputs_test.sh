@@ -32,13 +32,13 @@ fi
 expect_refusal "use --rate 1000, 2000, 3000, 4000" run spatula-sphere --lockstep --rate 700 --quiet --out "$run_dir"
 expect_refusal "at most 86400 s" run spatula-sphere --lockstep --duration 1e9 --quiet --out "$run_dir"
 sed 's/^time_step_s = 0.001 /time_step_s = 0.1   /' scenes/spatula-sphere.toml >"$work/coarse.toml"
-expect_refusal "fell through the ground while settling" run "$work/coarse.toml" --lockstep --quiet --out "$run_dir"
+expect_refusal "field 'simulation.time_step_s': must be in [1e-06, 0.005] (got 0.1)" run "$work/coarse.toml" --lockstep --quiet --out "$run_dir"
 after=$(cd "$run_dir" && md5sum trace.csv summary.json)
 [[ $before == "$after" ]] || bad "a refused run changed the earlier outputs:"$'\n'"$before"$'\n'"$after"
 [[ -z $(ls -A "$run_dir" | grep -v -x -e trace.csv -e summary.json) ]] || bad "temporaries left in $run_dir: $(ls -A "$run_dir")"
 
 echo "earlier csv" >"$work/sim.csv"
-expect_refusal "fell through the ground while settling" sim "$work/coarse.toml" --settle-seconds 1 --csv "$work/sim.csv"
+expect_refusal "field 'simulation.time_step_s': must be in [1e-06, 0.005] (got 0.1)" sim "$work/coarse.toml" --settle-seconds 1 --csv "$work/sim.csv"
 [[ $(cat "$work/sim.csv") == "earlier csv" ]] || bad "a refused fissure sim overwrote its --csv file"
 expect_refusal "at most 86400 s" sim spatula-sphere --seconds 1e9
 

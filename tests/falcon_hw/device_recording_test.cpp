@@ -1,9 +1,12 @@
 // Device recordings: SimFalcon recorded through RecordingDevice (the HapticDevice interface the
 // USB driver implements too) replays through ReplayDevice with the same readings at the same
-// times; the file round-trips; wrong magic, wrong version, truncation, a bad packet and lost
+// times, and so does the USB driver over the fake Falcon, its file laid out byte for byte as
+// docs/session.md documents it; the file round-trips; wrong magic, wrong version, truncation, a bad packet and lost
 // records are refused naming the file and the byte offset; the RT side never allocates.
 #include <unistd.h>
 
+#include <bit>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +18,8 @@
 #include <gtest/gtest.h>
 
 #include "fissure/falcon_hw/device_recording.hpp"
+#include "fissure/falcon_hw/fake_falcon_transport.hpp"
+#include "fissure/falcon_hw/falcon_usb_driver.hpp"
 #include "fissure/falcon_hw/recording_device.hpp"
 #include "fissure/falcon_hw/replay_device.hpp"
 #include "fissure/falcon_hw/sim_falcon.hpp"
@@ -181,6 +186,128 @@ TEST_F(DeviceRecordingTest, ReplayAtAnotherRateHoldsTheLatestRecordAndEndsDiscon
   clock.advance(ReplayDevice::kHoldAfterEnd_ns + kTick_ns);  // past the last record by more than the hold
   EXPECT_EQ(replay.try_exchange(DeviceCommand{}, reading), IoStatus::kDisconnected);
   EXPECT_EQ(replay.counters().after_end, 1);
+}
+
+/// Little-endian integer of sizeof(T) bytes at `offset`, assembled byte by byte (the file's byte
+/// order, whatever the host's).
+template <typename T>
+T little_endian(const std::vector<std::uint8_t>& data, std::size_t offset) {
+  std::uint64_t value = 0;
+  for (std::size_t i = 0; i < sizeof(T); ++i) value |= static_cast<std::uint64_t>(data.at(offset + i)) << (8 * i);
+  return static_cast<T>(value);
+}
+
+TEST_F(DeviceRecordingTest, TheUsbDriverIsRecordedAndReplayedWithTheSameReadingsAndTheDocumentedLayout) {
+  // The lab's path: FalconUsbDriver in front of the Falcon (here the fake one behind the fake
+  // FTDI bridge), wrapped in RecordingDevice, ticking at 1 kHz on a lockstep clock.
+  LockstepClock clock(0);
+  FakeFalconConfig fake_config;
+  fake_config.firmware_running = true;
+  fake_config.encoder_counts = {-400, -300, -200};
+  FakeFalconTransport fake(clock, fake_config);
+  FalconUsbConfig usb_config;
+  usb_config.reply_timeout_ns = 800'000;  // a lost reply times out inside its 1 ms tick
+  FalconUsbDriver driver(fake, clock, usb_config);
+  ASSERT_TRUE(driver.open()) << driver.error();
+  ASSERT_TRUE(driver.check_firmware()) << driver.error();
+  ASSERT_TRUE(driver.start_running()) << driver.error();
+  // The set-up took simulated time; the ticks start on the next whole millisecond.
+  const TimeNs start_ns = (clock.now() / kTick_ns + 1) * kTick_ns;
+  clock.sleep_until(start_ns);
+  const std::filesystem::path path = dir_ / "usb.frec";
+  RecordingDevice recording(driver, clock);
+  RecordingWriter writer(path, RecordingHeader{kRecordingVersion, 1000.0, recording.name(), "test-scene"});
+  fake.script_pull_out_push_in(500, 200);  // the grip moves over the first 400 replies
+  const std::size_t commands_before = fake.commands().size();
+  std::vector<Exchange> answered;
+  DeviceReading reading;
+  for (int k = 0; k < kTicks; ++k) {
+    clock.sleep_until(start_ns + k * kTick_ns);
+    if (k == 100) fake.set_buttons(0x1);
+    if (k == 350) fake.set_buttons(0x6);
+    // How the bytes arrive is not recorded, only what the driver made of them: torn replies and
+    // garbage before a reply read as ordinary ones (a later receive time); lost replies as timeouts.
+    if (k == 200) fake.inject_reply_faults(ReplyFault::kTear, 3);
+    if (k == 250) fake.inject_reply_faults(ReplyFault::kGarbageBefore, 3);
+    if (k == 300) fake.inject_reply_faults(ReplyFault::kDrop, 2);
+    const DeviceCommand command = command_for(reading);
+    answered.push_back({recording.try_exchange(command, reading), reading});
+    if (k % 50 == 49) recording.drain(writer);
+  }
+  recording.drain(writer);
+  writer.finish(recording.records_lost(), recording.recording_time(clock.now()));
+  ASSERT_EQ(fake.commands().size(), commands_before + kTicks);
+
+  // What the recorded session saw: motion, both button states, a timeout, a torn reply's later
+  // receive time (so the test below compares something in each field).
+  int timeouts = 0;
+  bool moved = false, buttons_changed = false, receive_offsets_differ = false;
+  for (std::size_t k = 0; k < answered.size(); ++k) {
+    timeouts += answered[k].status == IoStatus::kTimeout ? 1 : 0;
+    moved = moved || answered[k].reading.encoder_counts != answered[0].reading.encoder_counts;
+    buttons_changed = buttons_changed || answered[k].reading.buttons != answered[0].reading.buttons;
+    const TimeNs begin_ns = start_ns + static_cast<TimeNs>(k) * kTick_ns;
+    if (answered[k].status == IoStatus::kOk) {
+      receive_offsets_differ = receive_offsets_differ || answered[k].reading.receive_time_ns - begin_ns != fake_config.reply_latency_ns;
+    }
+  }
+  EXPECT_EQ(timeouts, 2);
+  EXPECT_TRUE(moved);
+  EXPECT_TRUE(buttons_changed);
+  EXPECT_TRUE(receive_offsets_differ);
+
+  // The file, read byte by byte against docs/session.md's table ("File format", version 1).
+  const std::vector<std::uint8_t> data = bytes(path);
+  EXPECT_EQ(std::string(data.begin(), data.begin() + 8), std::string("FISSREC\x1A", 8));
+  EXPECT_EQ(little_endian<std::uint32_t>(data, 8), 1u);
+  EXPECT_EQ(std::bit_cast<double>(little_endian<std::uint64_t>(data, 12)), 1000.0);
+  std::size_t at = 20;
+  const auto name_at = [&](const std::string& expected) {
+    const std::size_t length = little_endian<std::uint16_t>(data, at);
+    EXPECT_EQ(std::string(data.begin() + static_cast<std::ptrdiff_t>(at + 2), data.begin() + static_cast<std::ptrdiff_t>(at + 2 + length)), expected);
+    at += 2 + length;
+  };
+  name_at("usb-falcon");
+  name_at("test-scene");
+  for (std::size_t k = 0; k < answered.size(); ++k, at += 50) {
+    SCOPED_TRACE("exchange record " + std::to_string(k));
+    const Exchange& x = answered[k];
+    const TimeNs begin_ns = start_ns + static_cast<TimeNs>(k) * kTick_ns;
+    const bool ok = x.status == IoStatus::kOk;
+    ASSERT_EQ(data.at(at), 'X');
+    EXPECT_EQ(little_endian<std::int64_t>(data, at + 1), static_cast<TimeNs>(k) * kTick_ns);  // from the recording's start
+    EXPECT_EQ(little_endian<std::int64_t>(data, at + 9), ok ? x.reading.receive_time_ns - begin_ns : 0);
+    EXPECT_EQ(data.at(at + 17), ok ? 0 : 1);  // 0 ok, 1 timeout
+    FalconPacket reply{}, command{};
+    std::copy_n(data.begin() + static_cast<std::ptrdiff_t>(at + 18), 16, reply.begin());
+    std::copy_n(data.begin() + static_cast<std::ptrdiff_t>(at + 34), 16, command.begin());
+    EXPECT_EQ(reply, ok ? encode_reading(x.reading) : FalconPacket{});  // zeros unless ok
+    EXPECT_EQ(command, encode_command(fake.commands()[commands_before + k]));  // the packet the device received
+  }
+  ASSERT_EQ(data.at(at), 'E');
+  EXPECT_EQ(little_endian<std::uint64_t>(data, at + 1), static_cast<std::uint64_t>(kTicks));
+  EXPECT_EQ(little_endian<std::uint64_t>(data, at + 9), 0u);  // none lost
+  EXPECT_EQ(little_endian<std::int64_t>(data, at + 17), clock.now() - start_ns);
+  EXPECT_EQ(data.size(), at + kEndRecordBytes);
+
+  // Replayed in CI: the same statuses, encoder counts, buttons, homed flags and receive times
+  // (counted from the replay's start, as the recording counts from its own).
+  const DeviceRecording read_back = read_recording(path);
+  EXPECT_EQ(read_back.header.device_name, "usb-falcon");
+  LockstepClock replay_clock(0);
+  ReplayDevice replay(read_back, replay_clock);
+  DeviceReading replayed;
+  for (std::size_t k = 0; k < answered.size(); ++k) {
+    replay_clock.sleep_until(static_cast<TimeNs>(k) * kTick_ns);
+    const IoStatus status = replay.try_exchange(command_for(replayed), replayed);
+    ASSERT_EQ(status, answered[k].status) << "exchange " << k;
+    EXPECT_EQ(replayed.encoder_counts, answered[k].reading.encoder_counts) << "exchange " << k;
+    EXPECT_EQ(replayed.buttons, answered[k].reading.buttons) << "exchange " << k;
+    EXPECT_EQ(replayed.homed_mask, answered[k].reading.homed_mask) << "exchange " << k;
+    EXPECT_EQ(replayed.receive_time_ns, answered[k].reading.receive_time_ns - start_ns) << "exchange " << k;
+  }
+  EXPECT_EQ(replay.counters().records_used, kTicks);
+  EXPECT_EQ(replay.counters().commands_differing, 0);  // the replayed loop sent the recorded commands
 }
 
 TEST_F(DeviceRecordingTest, RecordsOfTheSameTimeAreTakenOneExchangeEach) {

@@ -137,6 +137,11 @@ TEST(SceneLoader, OutOfRangeValueNamesField) {
   const std::string good = read(kScenes / "spatula-sphere.toml");
   const std::string bad = replace(good, "linear_stiffness_ratio = 1.0", "linear_stiffness_ratio = 2.0");
   expect_error(load_error(bad), line_of(bad, "linear_stiffness_ratio"), "soft_body.linear_stiffness_ratio", "must be in");
+  // A host step at which the shipped bodies turn inside out (0.01 s) is refused before anything
+  // runs; the largest that works (0.005 s) loads.
+  const std::string coarse = replace(good, "time_step_s = 0.001 ", "time_step_s = 0.01  ");
+  expect_error(load_error(coarse), line_of(coarse, "time_step_s"), "simulation.time_step_s", "must be in [1e-06, 0.005] (got 0.01)");
+  EXPECT_NO_THROW((void)load_scene_text(replace(good, "time_step_s = 0.001 ", "time_step_s = 0.005 "), "ok.toml", kScenes));
   const std::string bad_method = replace(good, "collision_method = \"paired\"", "collision_method = \"magic\"");
   expect_error(load_error(bad_method), line_of(bad_method, "collision_method"), "simulation.collision_method",
                "'magic' is not one of: paired, ray, bullet");

@@ -36,7 +36,7 @@ struct ReplayCounters {
 class ReplayDevice final : public HapticDevice {
  public:
   /// How long past the last record the last answer is held [ns]: longer than any host step
-  /// (the scenes' time_step_s is at most 0.1 s) by a margin, far shorter than a session.
+  /// (a scene's time_step_s is at most 0.005 s) by a margin, far shorter than a session.
   static constexpr TimeNs kHoldAfterEnd_ns = 250'000'000;
 
   /// `recording` and `clock` must outlive the ReplayDevice. Throws RecordingError for a
