@@ -893,11 +893,6 @@ std::vector<StressCase> stress_cases() {
   // by name with the module and reason: the ci profile then reports them as KNOWN instead of
   // failing; the full profile always fails on them (docs/decisions.md lists the fixed ones).
   const std::vector<std::pair<const char*, std::string>> known = {
-      {"friction_grip_and_yank",
-       "host_sim in_solver contact (issue 22): a vessel node at a jaw's corner edge is thrown round it within one step "
-       "(t = 2.247 s): the rim projections of its fan of cut triangles, whose other corners are held on the two faces "
-       "meeting at the edge, move it 2-8 mm each way per iteration, and its straight start-to-end path clips the "
-       "corner by 0.12 mm (each iteration's move clears the jaw); after_step: 0 crossed on seeds 7, 1, 2"},
   };
   for (const auto& [name, reason] : known) {
     for (StressCase& c : cases) {

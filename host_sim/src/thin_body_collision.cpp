@@ -129,6 +129,7 @@ class ThinBodyCollisionImpl final : public ThinBodyCollision, public SoftContact
   void end_solve(btSoftBody& soft) override {
     if (!solved_ || !report_.broad_phase_hit || &soft != soft_) return;
     const Clock::time_point t0 = Clock::now();
+    report_.guard_corrections += thin_body::guard_swept_paths(model_, frame_, soft, data_, node_bounds_);
     thin_body::inelastic_rim_velocities(frame_, soft, data_);
     report_.seconds_response += seconds_between(t0, Clock::now());
   }

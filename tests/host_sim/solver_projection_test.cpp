@@ -2,7 +2,8 @@
 // that presses into the slab, pulled along the face by a given move within one step. Inside the
 // cone (static × its Hunt-Crossley normal force F_n × h²/m) the move is undone whole; beyond it,
 // undone by kinetic × F_n·h²/m only, however many projection passes run; the force on the tool is
-// m·correction/h² — exactly kinetic × F_n while sliding.
+// m·correction/h² — exactly kinetic × F_n while sliding. And the swept guard after the solve: a
+// node whose step path passes through the plate ends on the face that path enters by.
 #include "../../host_sim/src/thin_body/collision_state.hpp"
 #include "soft_scene_fixture.hpp"
 
@@ -151,6 +152,68 @@ TEST(SolverFriction, NoIndentationNoFriction) {
   EXPECT_DOUBLE_EQ(f.normal_force_n(), 0.0);
   f.pull_and_project(1e-4, 1);
   EXPECT_TRUE(f.result().friction_force_on_tool_world_n.isZero(0.0));
+}
+
+
+// The swept guard: the plate (40 × 2 × 40 mm, tool frame = world) stands still; a slab node
+// started 1 mm beside its +x side face, level with its middle, and the solve left it 0.5 mm above
+// the top face, 2 mm in from the corner — each position clear of the plate, the straight path
+// between them through the corner.
+struct SweptGuardFixture {
+  test_scene::SoftWorld world{false};
+  ToolNodes tool = test_scene::plate_tool(0.002);
+  CollisionModel model = slab_friction_model(world, tool);
+  CollisionData data;
+  StepFrame frame;
+  int node = 0;
+  Eigen::Vector3d start{0.021, 0.0, 0.0};
+
+  SweptGuardFixture() {
+    allocate_collision_data(model, data);
+    ToolPose pose;
+    data.step = 1;
+    frame = make_step_frame(model, data.step, pose, pose, kStep_s);
+    world.soft().m_sst.isdt = static_cast<btScalar>(1.0 / kStep_s);
+    data.broad.candidate_nodes.push_back(node);
+    data.broad.start_tool_m[static_cast<std::size_t>(node)] = start;
+    world.soft().m_nodes[node].m_q = btVector3(static_cast<btScalar>(start.x()), 0, 0);
+  }
+  void end_at(const Eigen::Vector3d& p) { world.soft().m_nodes[node].m_x = btVector3(static_cast<btScalar>(p.x()), static_cast<btScalar>(p.y()), static_cast<btScalar>(p.z())); }
+  [[nodiscard]] Eigen::Vector3d end() {
+    const btVector3& x = world.soft().m_nodes[node].m_x;
+    return {x.x(), x.y(), x.z()};
+  }
+};
+
+TEST(SweptGuard, ANodeCarriedRoundTheCornerEndsOnTheFaceItsPathEntersBy) {
+  SweptGuardFixture f;
+  const Eigen::Vector3d over_the_top(0.018, 0.0015, 0.0);
+  ASSERT_FALSE(segment_clears_tool(f.tool.planes(), f.start, over_the_top));
+  f.end_at(over_the_top);
+  EXPECT_EQ(guard_swept_paths(f.model, f.frame, f.world.soft(), f.data, nullptr), 1);
+  const Eigen::Vector3d end = f.end();
+  // The +x side face's plane (x = 20 mm) + skin, the rest of the move kept.
+  EXPECT_NEAR(end.x(), 0.02 + f.model.params.skin_m, 1e-6);
+  EXPECT_NEAR(end.y(), 0.0015, 1e-6);
+  EXPECT_TRUE(segment_clears_tool(f.tool.planes(), f.start, end));
+  const auto n = static_cast<std::size_t>(f.node);
+  EXPECT_EQ(f.data.displacement.hold_stamp[n], f.data.step);
+  EXPECT_GT(f.tool.planes()[static_cast<std::size_t>(f.data.displacement.hold_plane[n])].normal_tool.x(), 0.99);
+  // The velocity Bullet derives, from the new end.
+  const btSoftBody::Node& soft_node = f.world.soft().m_nodes[f.node];
+  const double scale = (1.0 - f.world.soft().m_cfg.kDP) / kStep_s;
+  EXPECT_NEAR(soft_node.m_v.y(), 0.0015 * scale, 1e-4);
+  EXPECT_NEAR(soft_node.m_v.x(), (end.x() - f.start.x()) * scale, 1e-4);
+}
+
+TEST(SweptGuard, APathBesideTheToolIsLeftAlone) {
+  SweptGuardFixture f;
+  const Eigen::Vector3d further_out(0.025, 0.003, 0.001);
+  f.end_at(further_out);
+  const btVector3 velocity_before = f.world.soft().m_nodes[f.node].m_v;
+  EXPECT_EQ(guard_swept_paths(f.model, f.frame, f.world.soft(), f.data, nullptr), 0);
+  EXPECT_TRUE(f.end().isApprox(further_out, 1e-7));
+  EXPECT_EQ(f.world.soft().m_nodes[f.node].m_v, velocity_before);
 }
 
 }  // namespace

@@ -259,6 +259,14 @@ DisplacementCounts enforce_displacement(const CollisionModel& model, const StepF
 // clip against every tool plane; the interior shrunk by the inside tolerance, so touching a face
 // or an edge is not "through").
 bool segment_clears_tool(const std::vector<ToolPlane>& planes, const Eigen::Vector3d& a, const Eigen::Vector3d& b);
+// After the in-solver solve and Bullet's velocity update: a candidate node whose straight path
+// over the step (start at the previous pose, end at the current one, both in the tool frame)
+// passes through the tool goes onto the face that path enters by, held there, its velocity
+// following. Why: each position iteration's move clears the tool, but a node carried round a
+// corner by several iterations (the rim projections of a fan of cut triangles throw a node on a
+// jaw's corner edge 2–8 mm per iteration) ends the step on a path through it, and Bullet's
+// velocity (x − q)/h is that path. Returns how many nodes were moved.
+int guard_swept_paths(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft, CollisionData& data, SoftNodeBounds* bounds);
 // enforce_displacement's three parts: place the contacted nodes (and guard), keep last step's held
 // nodes within release_distance colliding (after_step's hysteresis), and collect the force set
 // (every face around a colliding node) into contacted_faces.

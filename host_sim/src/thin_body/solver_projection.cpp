@@ -28,6 +28,9 @@
 //    twice, and m·correction/h² is the friction force the node puts on the tool.
 // The rim constraint (rim_projection.cpp) runs before this in each pass, so this projection,
 // which keeps nodes out of the tool, always has the last word.
+// guard_swept_paths, after the solve's velocity update: a node whose straight path over the step
+// passes through the tool (carried round a corner by several iterations) goes onto the face that
+// path enters by, so no node's step — which Bullet turns into its velocity — crosses the tool.
 // take_solved_shares, after the solve: a held node's share of the force is the smoothstep of its
 // final gap over release_distance (1 on the face, 0 at release), as the post-step hysteresis
 // ramps it; a node beyond release_distance or behind its plane is released.
@@ -222,6 +225,52 @@ void take_solved_shares(const CollisionModel& model, const StepFrame& frame, con
     data.displacement.moved_stamp[n] = frame.step;
     data.displacement.moved_nodes.push_back(node);
   }
+}
+
+}  // namespace fissure::host::thin_body
+
+namespace fissure::host::thin_body {
+
+int guard_swept_paths(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft, CollisionData& data, SoftNodeBounds* bounds) {
+  const auto& planes = model.tool.planes();
+  const double skin_m = model.params.skin_m;
+  // Bullet's own velocity update (v = (x − q)·(1 − kDP)/h), for the nodes moved after it.
+  const btScalar velocity_scale = soft.m_sst.isdt * (1 - soft.m_cfg.kDP);
+  int moved = 0;
+  for (const int node : data.broad.candidate_nodes) {
+    btSoftBody::Node& soft_node = soft.m_nodes[node];
+    if (soft_node.m_im == 0) continue;
+    const auto n = static_cast<std::size_t>(node);
+    const Eigen::Vector3d& start = data.broad.start_tool_m[n];
+    Eigen::Vector3d end = to_tool(frame, soft_node.m_x);
+    if (segment_clears_tool(planes, start, end)) continue;
+    // The face the path enters by: of the planes the start lies in front of and the path moves
+    // towards, the one it crosses last (Cyrus–Beck).
+    double t_enter = -1.0;
+    int enter_plane = -1;
+    for (std::size_t q = 0; q < planes.size(); ++q) {
+      const double height_start = planes[q].normal_tool.dot(start) - planes[q].offset_m;
+      const double height_end = planes[q].normal_tool.dot(end) - planes[q].offset_m;
+      if (height_start > 0.0 && height_end < height_start) {
+        const double t = height_start / (height_start - height_end);
+        if (t > t_enter) {
+          t_enter = t;
+          enter_plane = static_cast<int>(q);
+        }
+      }
+    }
+    if (enter_plane < 0) continue;  // it started inside the tool: the projections have put it out
+    const ToolPlane& plane = planes[static_cast<std::size_t>(enter_plane)];
+    // On that face's plane (+ skin) the whole path lies in front of it, and the tool behind it.
+    end += (plane.offset_m + skin_m - plane.normal_tool.dot(end)) * plane.normal_tool;
+    write_tool_position(frame, end, soft_node.m_x);
+    soft_node.m_v = (soft_node.m_x - soft_node.m_q) * velocity_scale;
+    data.displacement.hold_stamp[n] = frame.step;
+    data.displacement.hold_plane[n] = enter_plane;
+    if (bounds != nullptr) bounds->extend(node, soft_node.m_x);
+    ++moved;
+  }
+  return moved;
 }
 
 }  // namespace fissure::host::thin_body
