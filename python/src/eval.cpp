@@ -44,6 +44,19 @@ std::string json_text(Bench&& bench) {
   return result.dump();
 }
 
+/// A benchmark whose only option is `quick`: `name(quick)` runs it and returns its JSON text.
+template <typename Options>
+void bind_quick_only(py::module_& m, const char* name, nlohmann::json (*run)(const Options&)) {
+  m.def(
+      name,
+      [run](bool quick) {
+        Options o;
+        o.quick = quick;
+        return json_text([&] { return run(o); });
+      },
+      py::arg("quick"));
+}
+
 }  // namespace
 
 void bind_eval(py::module_& m) {
@@ -59,30 +72,9 @@ void bind_eval(py::module_& m) {
         return json_text([&] { return eval::run_bench_collision(o); });
       },
       py::arg("quick"), py::arg("full"), py::arg("only"), py::arg("contact_response"), py::arg("in_solver_friction"));
-  m.def(
-      "_bench_grasp",
-      [](bool quick) {
-        eval::BenchGraspOptions o;
-        o.quick = quick;
-        return json_text([&] { return eval::run_bench_grasp(o); });
-      },
-      py::arg("quick"));
-  m.def(
-      "_bench_mesh",
-      [](bool quick) {
-        eval::BenchMeshOptions o;
-        o.quick = quick;
-        return json_text([&] { return eval::run_bench_mesh(o); });
-      },
-      py::arg("quick"));
-  m.def(
-      "_bench_tissue",
-      [](bool quick) {
-        eval::BenchTissueOptions o;
-        o.quick = quick;
-        return json_text([&] { return eval::run_bench_tissue(o); });
-      },
-      py::arg("quick"));
+  bind_quick_only<eval::BenchGraspOptions>(m, "_bench_grasp", &eval::run_bench_grasp);
+  bind_quick_only<eval::BenchMeshOptions>(m, "_bench_mesh", &eval::run_bench_mesh);
+  bind_quick_only<eval::BenchTissueOptions>(m, "_bench_tissue", &eval::run_bench_tissue);
   m.def(
       "_bench_kinematics",
       [](std::size_t samples, int repeats, std::uint64_t seed) {

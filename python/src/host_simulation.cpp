@@ -116,6 +116,17 @@ class PyHostSimulation {
   double jaw_gap_m_ = 0.0;                // the gap step() keeps when given none
 };
 
+/// (P, 3) float64: one vector per tool part, `vector_of(r, part)`.
+template <typename VectorOf>
+py::array_t<double> per_part(const HostStepResult& r, VectorOf vector_of) {
+  std::vector<double> out;
+  for (int p = 0; p < r.part_count; ++p) {
+    const Eigen::Vector3d v = vector_of(r, static_cast<std::size_t>(p));
+    out.insert(out.end(), {v.x(), v.y(), v.z()});
+  }
+  return to_array(std::move(out), {r.part_count, 3});
+}
+
 py::dict contacts_dict(const HostStepResult& r) {
   const auto n = static_cast<std::size_t>(r.contact_count);
   std::vector<std::int32_t> face(n), node(n), plane(n), jaw(n);
@@ -181,13 +192,7 @@ void bind_host(py::module_& m) {
                              "(3,) float64: total force on the tool [N, world], summed over parts")
       .def_property_readonly(
           "part_forces",
-          [](const StepResult& s) {
-            std::vector<double> f;
-            for (int p = 0; p < s.result.part_count; ++p) {
-              for (int k = 0; k < 3; ++k) f.push_back(s.result.part_force_world_n[static_cast<std::size_t>(p)][k]);
-            }
-            return to_array(std::move(f), {s.result.part_count, 3});
-          },
+          [](const StepResult& s) { return per_part(s.result, [](const HostStepResult& r, std::size_t p) { return r.part_force_world_n[p]; }); },
           "(P, 3) float64: force on each tool part [N, world]; P = 1 (spatula) or 2 (clamp: jaw A at +y, jaw B at −y)")
       .def_property_readonly(
           "friction_force",
@@ -200,11 +205,7 @@ void bind_host(py::module_& m) {
       .def_property_readonly(
           "part_friction_forces",
           [](const StepResult& s) {
-            std::vector<double> f;
-            for (int p = 0; p < s.result.part_count; ++p) {
-              for (int k = 0; k < 3; ++k) f.push_back(s.result.part_results[static_cast<std::size_t>(p)].friction_force_on_tool_world_n[k]);
-            }
-            return to_array(std::move(f), {s.result.part_count, 3});
+            return per_part(s.result, [](const HostStepResult& r, std::size_t p) { return r.part_results[p].friction_force_on_tool_world_n; });
           },
           "(P, 3) float64: the friction part of each part's force [N, world] (clamp: jaw A at +y, jaw B at −y)")
       .def_property_readonly("part_count", [](const StepResult& s) { return s.result.part_count; })

@@ -100,6 +100,12 @@ bool clip_line_to_tool(const std::vector<ToolPlane>& planes, const Eigen::Vector
   return true;
 }
 
+// Whether the triangle's three corners lie on or in front of `plane`.
+bool corners_in_front_of(const ToolPlane& plane, const SoftTriangleInTool& triangle) {
+  return plane.normal_tool.dot(triangle.x[0]) >= plane.offset_m && plane.normal_tool.dot(triangle.x[1]) >= plane.offset_m &&
+         plane.normal_tool.dot(triangle.x[2]) >= plane.offset_m;
+}
+
 // Whether a tool plane that one of the triangle's corners is held on this step has all three
 // corners on or in front of it.
 bool separated_by_a_held_plane(const CollisionModel& model, const StepFrame& frame, const CollisionData& data, const std::array<int, 3>& nodes,
@@ -107,21 +113,15 @@ bool separated_by_a_held_plane(const CollisionModel& model, const StepFrame& fra
   for (const int node : nodes) {
     const auto n = static_cast<std::size_t>(node);
     if (data.displacement.hold_stamp[n] != frame.step || data.displacement.hold_plane[n] < 0) continue;
-    const ToolPlane& plane = model.tool.planes()[static_cast<std::size_t>(data.displacement.hold_plane[n])];
-    if (plane.normal_tool.dot(triangle.x[0]) >= plane.offset_m && plane.normal_tool.dot(triangle.x[1]) >= plane.offset_m &&
-        plane.normal_tool.dot(triangle.x[2]) >= plane.offset_m)
-      return true;
+    if (corners_in_front_of(model.tool.planes()[static_cast<std::size_t>(data.displacement.hold_plane[n])], triangle)) return true;
   }
   return false;
 }
 
 // Whether some tool face plane has all three of the triangle's corners on or in front of it.
 bool separated_by_a_tool_plane(const CollisionModel& model, const SoftTriangleInTool& triangle) {
-  for (const ToolPlane& plane : model.tool.planes())
-    if (plane.normal_tool.dot(triangle.x[0]) >= plane.offset_m && plane.normal_tool.dot(triangle.x[1]) >= plane.offset_m &&
-        plane.normal_tool.dot(triangle.x[2]) >= plane.offset_m)
-      return true;
-  return false;
+  return std::any_of(model.tool.planes().begin(), model.tool.planes().end(),
+                     [&triangle](const ToolPlane& plane) { return corners_in_front_of(plane, triangle); });
 }
 
 }  // namespace

@@ -45,6 +45,36 @@
 namespace fissure::host::thin_body {
 namespace {
 
+// Of the tool's planes along the segment a → b: the one it enters the tool by (Cyrus–Beck: of the
+// planes a lies in front of and b behind, the one crossed last; -1 when there is none) and the
+// one b lies least behind.
+struct PlaneCrossing {
+  int entered = -1;
+  int nearest_to_end = 0;
+};
+
+PlaneCrossing cross_tool_planes(const std::vector<ToolPlane>& planes, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  PlaneCrossing out;
+  double t_enter = 0.0;
+  double nearest_height = -std::numeric_limits<double>::infinity();
+  for (std::size_t q = 0; q < planes.size(); ++q) {
+    const double fa = planes[q].normal_tool.dot(a) - planes[q].offset_m;
+    const double fb = planes[q].normal_tool.dot(b) - planes[q].offset_m;
+    if (fb > nearest_height) {
+      nearest_height = fb;
+      out.nearest_to_end = static_cast<int>(q);
+    }
+    if (fa > 0.0 && fb < 0.0) {
+      const double t = fa / (fa - fb);
+      if (t >= t_enter) {
+        t_enter = t;
+        out.entered = static_cast<int>(q);
+      }
+    }
+  }
+  return out;
+}
+
 // The plane a free node found inside the tool leaves by (see the file comment for the order).
 int exit_plane(const CollisionModel& model, const StepFrame& frame, const CollisionData& data, int node, const Eigen::Vector3d& a,
                const Eigen::Vector3d& p_tool) {
@@ -55,26 +85,8 @@ int exit_plane(const CollisionModel& model, const StepFrame& frame, const Collis
     const ToolPlane& held = planes[static_cast<std::size_t>(data.displacement.hold_plane[n])];
     if (held.offset_m - held.normal_tool.dot(p_tool) <= reach_m) return data.displacement.hold_plane[n];
   }
-  double t_enter = 0.0;
-  int enter_plane = -1;
-  int nearest_plane = 0;
-  double nearest_height = -std::numeric_limits<double>::infinity();
-  for (std::size_t q = 0; q < planes.size(); ++q) {
-    const double fa = planes[q].normal_tool.dot(a) - planes[q].offset_m;
-    const double fb = planes[q].normal_tool.dot(p_tool) - planes[q].offset_m;
-    if (fb > nearest_height) {
-      nearest_height = fb;
-      nearest_plane = static_cast<int>(q);
-    }
-    if (fa > 0.0 && fb < 0.0) {
-      const double t = fa / (fa - fb);
-      if (t >= t_enter) {
-        t_enter = t;
-        enter_plane = static_cast<int>(q);
-      }
-    }
-  }
-  return enter_plane >= 0 ? enter_plane : nearest_plane;
+  const PlaneCrossing crossing = cross_tool_planes(planes, a, p_tool);
+  return crossing.entered >= 0 ? crossing.entered : crossing.nearest_to_end;
 }
 
 }  // namespace
@@ -227,9 +239,6 @@ void take_solved_shares(const CollisionModel& model, const StepFrame& frame, con
   }
 }
 
-}  // namespace fissure::host::thin_body
-
-namespace fissure::host::thin_body {
 
 int guard_swept_paths(const CollisionModel& model, const StepFrame& frame, btSoftBody& soft, CollisionData& data, SoftNodeBounds* bounds) {
   const auto& planes = model.tool.planes();
@@ -244,21 +253,8 @@ int guard_swept_paths(const CollisionModel& model, const StepFrame& frame, btSof
     const Eigen::Vector3d& start = data.broad.start_tool_m[n];
     Eigen::Vector3d end = to_tool(frame, soft_node.m_x);
     if (segment_clears_tool(planes, start, end)) continue;
-    // The face the path enters by: of the planes the start lies in front of and the path moves
-    // towards, the one it crosses last (Cyrus–Beck).
-    double t_enter = -1.0;
-    int enter_plane = -1;
-    for (std::size_t q = 0; q < planes.size(); ++q) {
-      const double height_start = planes[q].normal_tool.dot(start) - planes[q].offset_m;
-      const double height_end = planes[q].normal_tool.dot(end) - planes[q].offset_m;
-      if (height_start > 0.0 && height_end < height_start) {
-        const double t = height_start / (height_start - height_end);
-        if (t > t_enter) {
-          t_enter = t;
-          enter_plane = static_cast<int>(q);
-        }
-      }
-    }
+    // The face the path enters by: the path passes through the tool, so it crosses one.
+    const int enter_plane = cross_tool_planes(planes, start, end).entered;
     if (enter_plane < 0) continue;  // it started inside the tool: the projections have put it out
     const ToolPlane& plane = planes[static_cast<std::size_t>(enter_plane)];
     // On that face's plane (+ skin) the whole path lies in front of it, and the tool behind it.
