@@ -127,10 +127,10 @@ std::vector<std::pair<double, double>> indentation_curve(const SceneDescription&
 
 SceneDescription sphere_scene(int faces, bool icosphere, host::ContactResponse response) {
   SceneDescription s = with_response(base_scene(), response);
-  host::SoftSphere sphere = std::get<host::SoftSphere>(s.soft_body.shape);
+  host::SoftSphere sphere = std::get<host::SoftSphere>(s.soft_bodies.front().shape);
   sphere.faces_count = faces;
   sphere.tessellation = icosphere ? host::SphereTessellation::kIcosphere : host::SphereTessellation::kBulletEllipsoid;
-  s.soft_body.shape = sphere;
+  s.soft_bodies.front().shape = sphere;
   // The indentation is about the contact law, not the ball sagging: no gravity, the ball
   // just touches the ground. A plate wider than any contact patch.
   s.simulation.gravity_world_m_per_s2 = {0.0, 0.0, 0.0};
@@ -139,7 +139,7 @@ SceneDescription sphere_scene(int faces, bool icosphere, host::ContactResponse r
   // cap falls away from a held plate (a fine mesh loses more than half its contacts within
   // seconds) and the contact patch becomes a property of the mesh. Pose matching (Bullet kMT)
   // is the mesh-independent restoring force (each node pulled towards its rest place).
-  s.soft_body.shape_matching_ratio = kShapeMatchingRatio;
+  s.soft_bodies.front().shape_matching_ratio = kShapeMatchingRatio;
   s.tool.box_size_m = {0.1, 0.002, 0.1};
   s.tool.node_spacing_m = 0.002;
   return s;
@@ -277,9 +277,9 @@ double run_indentation(const SceneDescription& base, const std::vector<int>& mes
   shape.center_world_m = {0.0, 0.0125, 0.0};
   shape.size_m = {0.08, 0.02, 0.08};
   shape.top_cells_count = {16, 16};
-  slab.soft_body.shape = shape;
+  slab.soft_bodies.front().shape = shape;
   slab.simulation.gravity_world_m_per_s2 = {0.0, 0.0, 0.0};
-  slab.soft_body.shape_matching_ratio = kShapeMatchingRatio;  // see sphere_scene()
+  slab.soft_bodies.front().shape_matching_ratio = kShapeMatchingRatio;  // see sphere_scene()
   slab.tool.box_size_m = {0.04, 0.002, 0.04};  // smaller than the slab: the contact set is fixed
   slab.tool.node_spacing_m = 0.002;
   const std::vector<double> depths = {0.0005, 0.001, 0.0015, 0.002, 0.003, 0.004};

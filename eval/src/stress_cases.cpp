@@ -150,7 +150,7 @@ void random_hand(StressSetup& s, HandStyle style, std::uint64_t seed) {
 
 /// [[soft_body.anchor]] over the ball's bottom cap (kAnchorCapHeight_m, stress_cases.hpp says why).
 void anchor_bottom_cap(host::SceneDescription& scene) {
-  const std::vector<Vec3> rest = host::soft_body_rest_nodes_world_m(scene.soft_body);
+  const std::vector<Vec3> rest = host::soft_body_rest_nodes_world_m(scene.soft_bodies.front());
   double lowest_m = std::numeric_limits<double>::infinity();
   for (const Vec3& v : rest) lowest_m = std::min(lowest_m, v[1]);
   // x and z: the whole ground (half extents), so the cap is selected by height alone.
@@ -158,7 +158,7 @@ void anchor_bottom_cap(host::SceneDescription& scene) {
   host::SoftAnchorBox cap;
   cap.min_world_m = {-half[0], lowest_m, -half[2]};
   cap.max_world_m = {half[0], lowest_m + kAnchorCapHeight_m, half[2]};
-  scene.soft_body.anchors.push_back(cap);
+  scene.soft_bodies.front().anchors.push_back(cap);
 }
 
 // ---- case groups -------------------------------------------------------------------------------
@@ -915,7 +915,7 @@ std::uint64_t stress_case_seed(std::uint64_t base_seed, const std::string& case_
 double script_contact_share(const StressSetup& setup) {
   const host::SceneDescription& scene = setup.scene;
   const DeviceMapping& map = scene.device_mapping;
-  const auto* sphere = std::get_if<host::SoftSphere>(&scene.soft_body.shape);
+  const auto* sphere = std::get_if<host::SoftSphere>(&scene.soft_bodies.front().shape);
   if (sphere == nullptr || scene.tool.kind == host::ToolKind::kClamp || map.clamp_mode) {
     throw std::invalid_argument("script_contact_share: needs a spatula-type tool over a sphere");
   }

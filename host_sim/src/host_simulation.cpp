@@ -51,6 +51,43 @@ ToolVolume build_volume(const SceneDescription& scene) {
   return ToolVolume::from_box(0.5 * Eigen::Vector3d(size[0], size[1], size[2]));
 }
 
+// A part's report over several soft bodies: forces and counts add, the contacts join (each
+// stamped with its body), the stage times add.
+void accumulate(const CollisionStepResult& from, int body, CollisionStepResult& into) noexcept {
+  into.force_on_tool_world_n += from.force_on_tool_world_n;
+  into.friction_force_on_tool_world_n += from.friction_force_on_tool_world_n;
+  into.sticking_nodes += from.sticking_nodes;
+  into.sliding_nodes += from.sliding_nodes;
+  for (const ContactRecord& c : from.contacts) {
+    if (into.contacts.size() == into.contacts.capacity()) break;
+    into.contacts.push_back(c);
+    into.contacts.back().soft_body = body;
+  }
+  into.colliding_tool_nodes += from.colliding_tool_nodes;
+  into.excluded_pairs += from.excluded_pairs;
+  into.both_face_contacts += from.both_face_contacts;
+  into.contacted_triangles += from.contacted_triangles;
+  into.displaced_soft_nodes += from.displaced_soft_nodes;
+  into.guard_corrections += from.guard_corrections;
+  into.broad_phase_hit = into.broad_phase_hit || from.broad_phase_hit;
+  into.seconds_broad += from.seconds_broad;
+  into.seconds_narrow += from.seconds_narrow;
+  into.seconds_response += from.seconds_response;
+  into.seconds_force += from.seconds_force;
+  into.seconds_in_solver += from.seconds_in_solver;
+}
+
+void clear_for_accumulation(CollisionStepResult& r) noexcept {
+  r.force_on_tool_world_n.setZero();
+  r.friction_force_on_tool_world_n.setZero();
+  r.sticking_nodes = r.sliding_nodes = 0;
+  r.contacts.clear();
+  r.colliding_tool_nodes = r.excluded_pairs = r.both_face_contacts = r.contacted_triangles = 0;
+  r.displaced_soft_nodes = r.guard_corrections = 0;
+  r.broad_phase_hit = false;
+  r.seconds_broad = r.seconds_narrow = r.seconds_response = r.seconds_force = r.seconds_in_solver = 0.0;
+}
+
 ToolPose interpolate(const ToolPose& a, const ToolPose& b, double s) {
   ToolPose out;
   out.position_world_m = a.position_world_m + s * (b.position_world_m - a.position_world_m);
@@ -64,14 +101,18 @@ HostSimulation::HostSimulation(const SceneDescription& scene, std::optional<Scen
     : scene_(scene), method_(method.value_or(scene.simulation.collision_method)) {
   const bool bullet = method_ == SceneCollisionMethod::kBullet;
   world_ = std::make_unique<SoftWorld>(scene_, bullet, bullet || options.solver_node_bounds);
-  btSoftBody& soft = world_->soft();
   const int parts = world_->part_count();
+  const int bodies = world_->soft_body_count();
+  int faces_total = 0;
+  for (int b = 0; b < bodies; ++b) faces_total += world_->soft(b).m_faces.size();
+  const int nodes_total = world_->first_node(bodies);
   tool_pose_ = to_tool_pose(scene_.trajectory.start);
   jaw_gap_m_ = scene_.trajectory.start_jaw_gap_m >= 0.0 ? scene_.trajectory.start_jaw_gap_m : scene_.tool.clamp.jaw_gap_open_m;
   tool_part_poses(scene_, tool_pose_, jaw_gap_m_, part_poses_);
+  collisions_.resize(static_cast<std::size_t>(bodies * parts));
   for (int p = 0; p < parts; ++p) {
     if (bullet) {
-      collisions_[static_cast<std::size_t>(p)] = std::make_unique<BulletCollision>(*world_->probe(), world_->part_body(p), p);
+      collisions_[static_cast<std::size_t>(p)] = std::make_unique<BulletCollision>(*world_->probe(), world_->part_body(p), p);  // one body (SoftWorld)
     } else {
       tool_nodes_.push_back(build_tool_nodes(scene_));
     }
@@ -82,33 +123,49 @@ HostSimulation::HostSimulation(const SceneDescription& scene, std::optional<Scen
     params.response = scene_.simulation.contact_response;
     params.friction_static_ratio = scene_.tool.friction_static_ratio;
     params.friction_kinetic_ratio = scene_.tool.friction_kinetic_ratio;
-    for (int p = 0; p < parts; ++p) {
-      params.jaw = p;
-      const ToolNodes& nodes = tool_nodes_[static_cast<std::size_t>(p)];
-      SoftNodeBounds* bounds = world_->node_bounds();
-      collisions_[static_cast<std::size_t>(p)] = method_ == SceneCollisionMethod::kPaired ? make_paired_collision(nodes, soft, params, bounds)
-                                                                                          : make_ray_collision(nodes, soft, params, bounds);
-    }
-    if (params.response == ContactResponse::kInSolver) {
-      // The contact is solved in the NodeBoundsSolver's own copy of Bullet's position block, which
-      // it runs only for a body it can reproduce (node_bounds_solver.cpp).
-      NodeBoundsSolver* solver = world_->node_bounds_solver();
-      if (solver == nullptr)
-        throw std::invalid_argument("contact_response = \"in_solver\" needs the instrumented soft-body solver (HostSimulationOptions::solver_node_bounds)");
-      if (soft.m_clusters.size() != 0 || soft.m_cfg.diterations != 0 || soft.m_cfg.piterations <= 0)
-        throw std::invalid_argument("contact_response = \"in_solver\" needs a soft body with position iterations, no clusters and no drift iterations");
-      for (int p = 0; p < parts; ++p) solver->add_contact(collisions_[static_cast<std::size_t>(p)]->solver_contact());
+    NodeBoundsSolver* solver = world_->node_bounds_solver();
+    if (params.response == ContactResponse::kInSolver && solver == nullptr)
+      throw std::invalid_argument("contact_response = \"in_solver\" needs the instrumented soft-body solver (HostSimulationOptions::solver_node_bounds)");
+    for (int b = 0; b < bodies; ++b) {
+      btSoftBody& soft = world_->soft(b);
+      for (int p = 0; p < parts; ++p) {
+        params.jaw = p;
+        const ToolNodes& nodes = tool_nodes_[static_cast<std::size_t>(p)];
+        SoftNodeBounds* bounds = world_->node_bounds(b);
+        collisions_[static_cast<std::size_t>(b * parts + p)] = method_ == SceneCollisionMethod::kPaired ? make_paired_collision(nodes, soft, params, bounds)
+                                                                                                       : make_ray_collision(nodes, soft, params, bounds);
+      }
+      if (params.response == ContactResponse::kInSolver) {
+        // The contact is solved in the NodeBoundsSolver's own copy of Bullet's position block, which
+        // it runs only for a body it can reproduce (node_bounds_solver.cpp).
+        if (soft.m_clusters.size() != 0 || soft.m_cfg.diterations != 0 || soft.m_cfg.piterations <= 0)
+          throw std::invalid_argument("contact_response = \"in_solver\" needs a soft body with position iterations, no clusters and no drift iterations");
+        for (int p = 0; p < parts; ++p) solver->add_contact(collisions_[static_cast<std::size_t>(b * parts + p)]->solver_contact(), b);
+      }
     }
   }
   const ToolVolume volume = build_volume(scene_);
-  for (int p = 0; p < parts; ++p) trackers_.emplace_back(volume, soft.m_nodes.size());
-  soft_faces_.resize(static_cast<std::size_t>(soft.m_faces.size()));
-  for (int f = 0; f < soft.m_faces.size(); ++f)
-    for (int k = 0; k < 3; ++k)
-      soft_faces_[static_cast<std::size_t>(f)][static_cast<std::size_t>(k)] = static_cast<int>(soft.m_faces[f].m_n[k] - &soft.m_nodes[0]);
+  for (int p = 0; p < parts; ++p) trackers_.emplace_back(volume, nodes_total);
+  soft_faces_.reserve(static_cast<std::size_t>(faces_total));
+  for (int b = 0; b < bodies; ++b) {
+    first_faces_.push_back(static_cast<int>(soft_faces_.size()));
+    const btSoftBody& soft = world_->soft(b);
+    const int first = world_->first_node(b);
+    for (int f = 0; f < soft.m_faces.size(); ++f) {
+      std::array<int, 3> face{};
+      for (std::size_t k = 0; k < 3; ++k) face[k] = first + static_cast<int>(soft.m_faces[f].m_n[k] - &soft.m_nodes[0]);
+      soft_faces_.push_back(face);
+    }
+  }
+  first_faces_.push_back(faces_total);
+  const int records = std::max(faces_total, nodes_total);
   result_.part_count = parts;
-  result_.contacts.reserve(static_cast<std::size_t>(parts * std::max(soft.m_faces.size(), soft.m_nodes.size())));
-  for (auto& r : result_.part_results) r.reserve_for(std::max(soft.m_faces.size(), soft.m_nodes.size()));
+  result_.contacts.reserve(static_cast<std::size_t>(parts * records));
+  for (auto& r : result_.part_results) r.reserve_for(records);
+  if (bodies > 1) {
+    body_part_results_.resize(static_cast<std::size_t>(bodies * parts));
+    for (auto& r : body_part_results_) r.reserve_for(records);
+  }
   for (int p = 0; p < parts; ++p) world_->set_part_pose(p, part_poses_[static_cast<std::size_t>(p)]);
   world_->copy_node_positions(nodes_);
   for (int p = 0; p < parts; ++p) trackers_[static_cast<std::size_t>(p)].reset(nodes_, to_isometry(part_poses_[static_cast<std::size_t>(p)]));
@@ -126,7 +183,7 @@ Eigen::AlignedBox3d HostSimulation::soft_bounds_world_m() const noexcept {
   return box;
 }
 
-int HostSimulation::soft_face_count() const noexcept { return world_->soft().m_faces.size(); }
+int HostSimulation::soft_face_count() const noexcept { return static_cast<int>(soft_faces_.size()); }
 int HostSimulation::triangles_cut_by_tool(double depth_tolerance_m) const {
   int cut = 0;
   for (int p = 0; p < world_->part_count(); ++p) {
@@ -136,14 +193,14 @@ int HostSimulation::triangles_cut_by_tool(double depth_tolerance_m) const {
   return cut;
 }
 
-int HostSimulation::soft_node_count() const noexcept { return world_->soft().m_nodes.size(); }
+int HostSimulation::soft_node_count() const noexcept { return world_->first_node(world_->soft_body_count()); }
 
 TrajectorySample HostSimulation::scripted_target() const noexcept { return sample_trajectory(scene_, time_s_ + scene_.simulation.time_step_s); }
 
 void HostSimulation::settle(double seconds) {
   const int steps = static_cast<int>(std::ceil(seconds / scene_.simulation.time_step_s));
   for (int i = 0; i < steps; ++i) step(tool_pose_, jaw_gap_m_);
-  for (int p = 0; p < world_->part_count(); ++p) collisions_[static_cast<std::size_t>(p)]->reset_rest_state(world_->soft());
+  for (std::size_t c = 0; c < collisions_.size(); ++c) collisions_[c]->reset_rest_state(world_->soft(static_cast<int>(c) / world_->part_count()));
   time_s_ = 0.0;  // the scripted trajectory starts after settling
   world_->copy_node_positions(nodes_);
   for (int p = 0; p < world_->part_count(); ++p) trackers_[static_cast<std::size_t>(p)].reset(nodes_, to_isometry(part_poses_[static_cast<std::size_t>(p)]));
@@ -156,10 +213,13 @@ int HostSimulation::reseat_tool(const ToolPose& tool_pose, double jaw_gap_m) {
   jaw_gap_m_ = clamp ? std::clamp(jaw_gap_m, scene_.tool.clamp.jaw_gap_min_m, scene_.tool.clamp.jaw_gap_open_m) : 0.0;
   tool_part_poses(scene_, tool_pose_, jaw_gap_m_, part_poses_);
   int put_out = 0;
-  for (int p = 0; p < world_->part_count(); ++p) {
-    const auto k = static_cast<std::size_t>(p);
-    world_->teleport_part(p, part_poses_[k]);
-    put_out += collisions_[k]->reseat(previous[k], part_poses_[k], world_->soft());
+  const int parts = world_->part_count();
+  for (int p = 0; p < parts; ++p) world_->teleport_part(p, part_poses_[static_cast<std::size_t>(p)]);
+  for (int b = 0; b < world_->soft_body_count(); ++b) {
+    for (int p = 0; p < parts; ++p) {
+      const auto k = static_cast<std::size_t>(p);
+      put_out += collisions_[static_cast<std::size_t>(b * parts + p)]->reseat(previous[k], part_poses_[k], world_->soft(b));
+    }
   }
   // The crossing metric judges each node's relative path between two updates: from the old pose
   // to the new one every node in between would count as "through". A re-seat is not a path; the
@@ -172,6 +232,7 @@ int HostSimulation::reseat_tool(const ToolPose& tool_pose, double jaw_gap_m) {
 const HostStepResult& HostSimulation::step(const ToolPose& tool_target, double jaw_gap_m) {
   const Clock::time_point start = Clock::now();
   const int parts = world_->part_count();
+  const int bodies = world_->soft_body_count();
   const int substeps = scene_.simulation.substeps_count;
   const double h = scene_.simulation.time_step_s / substeps;
   const bool clamp = scene_.tool.kind == ToolKind::kClamp;
@@ -187,24 +248,30 @@ const HostStepResult& HostSimulation::step(const ToolPose& tool_target, double j
     tool_pose_ = interpolate(from, tool_target, a);
     jaw_gap_m_ = clamp ? gap_from + a * (gap_target - gap_from) : 0.0;
     tool_part_poses(scene_, tool_pose_, jaw_gap_m_, part_poses_);
-    for (int p = 0; p < parts; ++p) {
-      const auto k = static_cast<std::size_t>(p);
-      world_->set_part_pose(p, part_poses_[k]);
-      collisions_[k]->prepare_step(previous[k], part_poses_[k], h);  // in_solver: detected and solved inside the step
+    for (int p = 0; p < parts; ++p) world_->set_part_pose(p, part_poses_[static_cast<std::size_t>(p)]);
+    for (std::size_t c = 0; c < collisions_.size(); ++c) {
+      const auto k = c % static_cast<std::size_t>(parts);
+      collisions_[c]->prepare_step(previous[k], part_poses_[k], h);  // in_solver: detected and solved inside the step
     }
     const Clock::time_point bullet_start = Clock::now();
     world_->step(h);
     result_.times.bullet_s += seconds_since(bullet_start);
     for (int p = 0; p < parts; ++p) {
-      const auto k = static_cast<std::size_t>(p);
-      CollisionStepResult& r = result_.part_results[k];
+      if (bodies > 1) clear_for_accumulation(result_.part_results[static_cast<std::size_t>(p)]);
+    }
+    for (std::size_t c = 0; c < collisions_.size(); ++c) {
+      const int body = static_cast<int>(c) / parts;
+      const auto k = c % static_cast<std::size_t>(parts);
+      // One body (most scenes): the collision reports straight into its part's result.
+      CollisionStepResult& r = bodies > 1 ? body_part_results_[c] : result_.part_results[k];
       const Clock::time_point collision_start = Clock::now();
-      collisions_[k]->step(previous[k], part_poses_[k], h, world_->soft(), r);
+      collisions_[c]->step(previous[k], part_poses_[k], h, world_->soft(body), r);
       // bullet's collision ran inside stepSimulation (measured by the probe); ours runs here.
       result_.times.collision_s += method_ == SceneCollisionMethod::kBullet ? r.seconds_narrow + r.seconds_response : seconds_since(collision_start);
       // In-solver, the detection and the projections ran inside Bullet's step: they are ours.
       result_.times.collision_s += r.seconds_in_solver;
       result_.times.bullet_s -= r.seconds_in_solver;
+      if (bodies > 1) accumulate(r, body, result_.part_results[k]);
     }
     previous = part_poses_;
     // The metrics follow every sub-step: the crossing tracker judges each node's relative path

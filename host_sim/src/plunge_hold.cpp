@@ -28,12 +28,12 @@ SceneDescription plunge_scene(const PlungeTool& tool, int icosphere_faces) {
     s.tool.box_size_m = tool.box_size_m;
   }
   s.trajectory.start.orientation_world = quat_from_rpy_deg(tool.orientation_rpy_deg);
-  s.soft_body.shape_matching_ratio = kPlungeShapeMatchingRatio;
+  s.soft_bodies.front().shape_matching_ratio = kPlungeShapeMatchingRatio;
   if (icosphere_faces > 0) {
-    SoftSphere sphere = std::get<SoftSphere>(s.soft_body.shape);
+    SoftSphere sphere = std::get<SoftSphere>(s.soft_bodies.front().shape);
     sphere.faces_count = icosphere_faces;
     sphere.tessellation = SphereTessellation::kIcosphere;
-    s.soft_body.shape = sphere;
+    s.soft_bodies.front().shape = sphere;
   }
   return s;
 }
@@ -45,7 +45,7 @@ SceneDescription in_solver_plunge_scene(SceneDescription scene, bool tool_fricti
   SoftAnchorBox bed;
   bed.min_world_m = {-1.0, scene.ground.top_height_m - 1.0, -1.0};
   bed.max_world_m = {1.0, scene.ground.top_height_m + kPlungeBedTop_m, 1.0};
-  scene.soft_body.anchors.push_back(bed);
+  scene.soft_bodies.front().anchors.push_back(bed);
   return scene;
 }
 

@@ -239,6 +239,29 @@ void read_soft_body(const std::string& file, TableReader& t, SoftBodyDescription
   t.finish();
 }
 
+// [soft_body] for one body, [[soft_body]] for several (each table read as the single one, its
+// anchors inside it as [[soft_body.anchor]]).
+void read_soft_bodies(const std::string& file, const toml::table& root, TableReader& top, std::vector<SoftBodyDescription>& bodies,
+                      const std::filesystem::path& base_dir) {
+  const toml::node* node = root.get("soft_body");
+  if (node == nullptr || !node->is_array()) {
+    TableReader t(file, *top.subtable("soft_body", true), "soft_body");
+    bodies.assign(1, SoftBodyDescription{});
+    read_soft_body(file, t, bodies.front(), base_dir);
+    return;
+  }
+  const toml::array& tables = *top.array_of_tables("soft_body");
+  if (tables.empty() || static_cast<int>(tables.size()) > kMaxSoftBodies) {
+    throw SceneError(file, std::max(1, line_of(*node)), "soft_body",
+                     "a scene holds 1 to " + std::to_string(kMaxSoftBodies) + " soft bodies (got " + std::to_string(tables.size()) + ")");
+  }
+  bodies.assign(tables.size(), SoftBodyDescription{});
+  for (std::size_t i = 0; i < tables.size(); ++i) {
+    TableReader t(file, *tables.get(i)->as_table(), "soft_body[" + std::to_string(i) + "]");
+    read_soft_body(file, t, bodies[i], base_dir);
+  }
+}
+
 void read_clamp(TableReader& t, ClampDescription& clamp) {
   clamp.jaw_size_m = t.vec3("jaw_size", "m");
   clamp.handle_size_m = t.vec3("handle_size", "m");
@@ -363,10 +386,7 @@ SceneDescription parse(const toml::table& root, const std::string& file, const s
     TableReader t(file, *top.subtable("ground", true), "ground");
     read_ground(t, scene.ground);
   }
-  {
-    TableReader t(file, *top.subtable("soft_body", true), "soft_body");
-    read_soft_body(file, t, scene.soft_body, base_dir);
-  }
+  read_soft_bodies(file, root, top, scene.soft_bodies, base_dir);
   {
     TableReader t(file, *top.subtable("tool", true), "tool");
     read_tool(file, t, scene.tool, base_dir);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <string>
 
 #include <Eigen/Geometry>
 
@@ -107,8 +108,18 @@ SoftWorld::SoftWorld(const SceneDescription& scene, bool tool_collides_in_bullet
     : geometry_(tool_part_geometry(scene)), parts_in_world_(tool_collides_in_bullet) {
   // The FEM body lives in Bullet's deformable world (fem_world.hpp), whose solver is not the
   // node-bounds solver the thin-body collision reads: refused rather than simulated as a shell.
-  if (scene.soft_body.model == SoftBodyModel::kFem) {
-    throw std::invalid_argument("[soft_body] model = \"fem\": the host simulation does not step FEM bodies yet (issue 24); `fissure bench tissue` runs them");
+  for (const SoftBodyDescription& body : scene.soft_bodies) {
+    if (body.model == SoftBodyModel::kFem) {
+      throw std::invalid_argument("[soft_body] model = \"fem\": the host simulation does not step FEM bodies yet (issue 24); `fissure bench tissue` runs them");
+    }
+  }
+  if (scene.soft_bodies.empty() || static_cast<int>(scene.soft_bodies.size()) > kMaxSoftBodies) {
+    throw std::invalid_argument("a scene holds 1 to " + std::to_string(kMaxSoftBodies) + " soft bodies (got " + std::to_string(scene.soft_bodies.size()) + ")");
+  }
+  // Bullet's own tool contact (the baseline) is measured by a probe that watches one body.
+  if (tool_collides_in_bullet && scene.soft_bodies.size() > 1) {
+    throw std::invalid_argument("the bullet collision method runs scenes with one soft body (this one has " + std::to_string(scene.soft_bodies.size()) +
+                                "); use paired or ray");
   }
   configuration_ = std::make_unique<btSoftBodyRigidBodyCollisionConfiguration>();
   dispatcher_ = std::make_unique<btCollisionDispatcher>(configuration_.get());
@@ -187,10 +198,12 @@ SoftWorld::SoftWorld(const SceneDescription& scene, bool tool_collides_in_bullet
     if (parts_in_world_) world_->addRigidBody(&body);
   }
 
-  soft_.reset(build_soft_body(info, scene.soft_body));
   // [[soft_body.anchor]]: tie the selected rest nodes to the ground (the bed the tissue lies on).
   try {
-    anchored_nodes_count_ = anchor_soft_body(*soft_, *ground_, scene.soft_body);
+    for (const SoftBodyDescription& description : scene.soft_bodies) {
+      softs_.emplace_back(build_soft_body(info, description));
+      anchored_nodes_count_ += anchor_soft_body(*softs_.back(), *ground_, description);
+    }
   } catch (...) {
     // The destructor does not run for a half-built world: take the bodies out of it here, or
     // the world's own destructor would touch their freed broadphase proxies.
@@ -200,18 +213,28 @@ SoftWorld::SoftWorld(const SceneDescription& scene, bool tool_collides_in_bullet
     world_->removeRigidBody(ground_.get());
     throw;
   }
-  world_->addSoftBody(soft_.get());
+  first_nodes_.push_back(0);
+  for (const auto& body : softs_) {
+    // Vertex–face soft–soft contact only (Bullet's classic handler runs VF_SS when it is the
+    // only soft–soft bit of both bodies): the cluster variant needs clusters, which the
+    // node-bounds solver does not reproduce.
+    if (softs_.size() > 1) body->m_cfg.collisions = btSoftBody::fCollision::SDF_RS | btSoftBody::fCollision::VF_SS;
+    world_->addSoftBody(body.get());
+    first_nodes_.push_back(first_nodes_.back() + body->m_nodes.size());
+  }
   if (probe_ != nullptr) {
     std::array<const btCollisionObject*, kMaxToolParts> objects{};
     for (int p = 0; p < geometry_.part_count; ++p) objects[static_cast<std::size_t>(p)] = parts_[static_cast<std::size_t>(p)].get();
-    probe_->attach(soft_.get(), objects);
+    probe_->attach(softs_.front().get(), objects);
   }
-  if (bounding_solver_ != nullptr) bounding_solver_->attach(soft_.get());
+  if (bounding_solver_ != nullptr) {
+    for (const auto& body : softs_) bounding_solver_->attach(body.get());
+  }
 }
 
 SoftWorld::~SoftWorld() {
   if (world_) {
-    world_->removeSoftBody(soft_.get());
+    for (const auto& body : softs_) world_->removeSoftBody(body.get());
     for (int p = 0; p < geometry_.part_count; ++p) {
       if (parts_in_world_) world_->removeRigidBody(parts_[static_cast<std::size_t>(p)].get());
     }
@@ -249,11 +272,14 @@ void SoftWorld::step(double h_s) noexcept {
 }
 
 void SoftWorld::copy_node_positions(std::vector<Eigen::Vector3d>& out) const {
-  const int n = soft_->m_nodes.size();
-  out.resize(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i) {
-    const btVector3& x = soft_->m_nodes[i].m_x;
-    out[static_cast<std::size_t>(i)] = Eigen::Vector3d(x.x(), x.y(), x.z());
+  out.resize(static_cast<std::size_t>(first_nodes_.back()));
+  for (std::size_t b = 0; b < softs_.size(); ++b) {
+    const btSoftBody& body = *softs_[b];
+    const auto first = static_cast<std::size_t>(first_nodes_[b]);
+    for (int i = 0; i < body.m_nodes.size(); ++i) {
+      const btVector3& x = body.m_nodes[i].m_x;
+      out[first + static_cast<std::size_t>(i)] = Eigen::Vector3d(x.x(), x.y(), x.z());
+    }
   }
 }
 

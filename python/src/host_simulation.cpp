@@ -39,6 +39,7 @@ using host::SceneDescription;
 struct StepResult {
   HostStepResult result;
   int cut_triangles = -1;
+  std::vector<int> first_face;  ///< where each soft body's triangles start in faces(): contacts' soft_face is made global
 };
 
 /// The scene with its contact response overridden, refused as the loader refuses a file that
@@ -63,11 +64,9 @@ class PyHostSimulation {
     host::HostSimulationOptions options;
     options.solver_node_bounds = solver_node_bounds;
     sim_ = std::make_unique<HostSimulation>(with_contact_response(scene, contact_response), parsed, options);
-    const btSoftBody& soft = sim_->world().soft();
-    const btSoftBody::Node* first = &soft.m_nodes[0];
-    faces_.reserve(static_cast<std::size_t>(soft.m_faces.size()) * 3);
-    for (int f = 0; f < soft.m_faces.size(); ++f) {
-      for (int v = 0; v < 3; ++v) faces_.push_back(static_cast<std::int32_t>(soft.m_faces[f].m_n[v] - first));
+    faces_.reserve(sim_->soft_faces().size() * 3);
+    for (const std::array<int, 3>& face : sim_->soft_faces()) {
+      for (int v : face) faces_.push_back(static_cast<std::int32_t>(v));
     }
     rest_ = sim_->node_positions_world_m();
     const bool clamp = scene.tool.kind == host::ToolKind::kClamp;
@@ -88,7 +87,8 @@ class PyHostSimulation {
 
   StepResult step(const py::handle& pose, const std::optional<double>& jaw_gap_m, bool count_cut_triangles, double cut_depth_tolerance_m) {
     const host::ToolPose target = tool_pose_from(pose, sim_->tool_pose());
-    StepResult out{sim_->step(target, jaw_gap_m.value_or(jaw_gap_m_)), -1};
+    StepResult out{sim_->step(target, jaw_gap_m.value_or(jaw_gap_m_)), -1, {}};
+    for (int b = 0; b < sim_->soft_body_count(); ++b) out.first_face.push_back(sim_->first_face(b));
     jaw_gap_m_ = out.result.jaw_gap_m;
     if (count_cut_triangles) out.cut_triangles = sim_->triangles_cut_by_tool(cut_depth_tolerance_m);
     return out;
@@ -127,13 +127,16 @@ py::array_t<double> per_part(const HostStepResult& r, VectorOf vector_of) {
   return to_array(std::move(out), {r.part_count, 3});
 }
 
-py::dict contacts_dict(const HostStepResult& r) {
+py::dict contacts_dict(const StepResult& s) {
+  const HostStepResult& r = s.result;
   const auto n = static_cast<std::size_t>(r.contact_count);
-  std::vector<std::int32_t> face(n), node(n), plane(n), jaw(n);
+  std::vector<std::int32_t> face(n), body(n), node(n), plane(n), jaw(n);
   std::vector<double> point(3 * n), normal(3 * n), penetration(n), rate(n), weight(n), force(n);
   for (std::size_t i = 0; i < n; ++i) {
     const host::ContactRecord& c = r.contacts[i];
-    face[i] = c.soft_face;
+    // Into faces(), which holds every body's triangles.
+    face[i] = s.first_face[static_cast<std::size_t>(c.soft_body)] + c.soft_face;
+    body[i] = c.soft_body;
     node[i] = c.tool_node;
     plane[i] = c.tool_plane;
     jaw[i] = c.jaw;
@@ -149,6 +152,7 @@ py::dict contacts_dict(const HostStepResult& r) {
   const auto rows = static_cast<py::ssize_t>(n);
   py::dict d;
   d["soft_face"] = to_array(std::move(face));
+  d["soft_body"] = to_array(std::move(body));
   d["tool_node"] = to_array(std::move(node));
   d["tool_plane"] = to_array(std::move(plane));
   d["jaw"] = to_array(std::move(jaw));
@@ -210,8 +214,9 @@ void bind_host(py::module_& m) {
           "(P, 3) float64: the friction part of each part's force [N, world] (clamp: jaw A at +y, jaw B at −y)")
       .def_property_readonly("part_count", [](const StepResult& s) { return s.result.part_count; })
       .def_property_readonly("contact_count", [](const StepResult& s) { return s.result.contact_count; })
-      .def_property_readonly("contacts", [](const StepResult& s) { return contacts_dict(s.result); },
-                             "Contacted soft triangles (C of them), a dict of arrays: soft_face (C,) int32, tool_node (C,)\n"
+      .def_property_readonly("contacts", [](const StepResult& s) { return contacts_dict(s); },
+                             "Contacted soft triangles (C of them), a dict of arrays: soft_face (C,) int32 (a row of faces()),\n"
+                             "soft_body (C,) int32 (which of the scene's soft bodies), tool_node (C,)\n"
                              "int32 (-1: none), tool_plane (C,) int32, jaw (C,) int32, point_world_m (C, 3) [m] (triangle\n"
                              "centroid after the response), normal_world (C, 3) (tool face outward normal), penetration_m (C,)\n"
                              "[m] (Hunt-Crossley deformation x), penetration_rate_m_s (C,) [m/s], weight (C,) (contacted rest\n"
@@ -304,7 +309,22 @@ void bind_host(py::module_& m) {
                              "collidable tool parts: 1, or 2 for a clamp")
       .def_property_readonly("soft_node_count", [](const PyHostSimulation& s) { return s.sim().soft_node_count(); })
       .def_property_readonly("soft_face_count", [](const PyHostSimulation& s) { return s.sim().soft_face_count(); })
-      .def_property_readonly("last", [](const PyHostSimulation& s) { return StepResult{s.sim().last(), -1}; },
+      .def_property_readonly("soft_body_count", [](const PyHostSimulation& s) { return s.sim().soft_body_count(); },
+                             "soft bodies in the scene ([[soft_body]]); node and face arrays hold them body after body")
+      .def(
+          "soft_body_nodes",
+          [](const PyHostSimulation& s, int body) {
+            if (body < 0 || body >= s.sim().soft_body_count())
+              throw py::index_error("soft body " + std::to_string(body) + " of " + std::to_string(s.sim().soft_body_count()));
+            return py::slice(s.sim().first_node(body), s.sim().first_node(body + 1), 1);
+          },
+          py::arg("body"), "slice of node_positions() rows that are soft body `body`'s nodes")
+      .def_property_readonly("last",
+                             [](const PyHostSimulation& s) {
+                               StepResult out{s.sim().last(), -1, {}};
+                               for (int b = 0; b < s.sim().soft_body_count(); ++b) out.first_face.push_back(s.sim().first_face(b));
+                               return out;
+                             },
                              "the last step's StepResult (zeros before the first)")
       .def(
           "node_positions", [](const PyHostSimulation& s) { return to_array(s.sim().node_positions_world_m()); },
@@ -325,7 +345,7 @@ void bind_host(py::module_& m) {
           "rest_positions", [](const PyHostSimulation& s) { return to_array(s.rest()); },
           "(N, 3) float64: the soft body's rest shape [m, world] — as built, and after settle() the settled shape\n"
           "(the Hunt-Crossley rest state). A copy.")
-      .def("faces", &PyHostSimulation::faces, "(F, 3) int32: node indices of each soft triangle (fixed topology). A copy.")
+      .def("faces", &PyHostSimulation::faces, "(F, 3) int32: node indices (rows of node_positions()) of every soft body's triangles, body after body (fixed topology). A copy.")
       .def(
           "soft_bounds",
           [](const PyHostSimulation& s) {

@@ -147,13 +147,13 @@ void bind_scene(py::module_& m) {
       .def_property_readonly("friction_kinetic_ratio", [](const SceneDescription& s) { return s.tool.friction_kinetic_ratio; },
                              "tool–tissue Coulomb friction, kinetic (≤ the static ratio)")
       .def_property_readonly("soft_model",
-                             [](const SceneDescription& s) { return std::string(s.soft_body.model == host::SoftBodyModel::kFem ? "fem" : "shell"); },
+                             [](const SceneDescription& s) { return std::string(s.soft_bodies.front().model == host::SoftBodyModel::kFem ? "fem" : "shell"); },
                              "'shell' (Bullet's mass-spring soft body) or 'fem' (Bullet's deformable-world FEM, SI material)")
       .def_property_readonly("tool_kind", [](const SceneDescription& s) { return std::string(tool_kind_name(s.tool.kind)); },
                              "'box', 'convex_mesh' or 'clamp'")
       .def_property_readonly("tool_box_size_m", [](const SceneDescription& s) { return vec(s.tool.box_size_m); },
                              "(3,) box tool extents [m]: x width, y thickness (thin axis), z length")
-      .def_property_readonly("soft_shape", [](const SceneDescription& s) { return std::string(soft_shape_name(s.soft_body)); },
+      .def_property_readonly("soft_shape", [](const SceneDescription& s) { return std::string(soft_shape_name(s.soft_bodies.front())); },
                              "'sphere', 'cylinder', 'slab' or 'mesh'")
       .def_property_readonly(
           "hunt_crossley",
@@ -183,7 +183,7 @@ void bind_scene(py::module_& m) {
           },
           py::arg("t_s"), "(ToolPose, jaw_gap_m) the scripted trajectory prescribes at time t_s [s].")
       .def("__repr__", [](const SceneDescription& s) {
-        return "Scene('" + s.name + "', tool=" + tool_kind_name(s.tool.kind) + ", soft=" + soft_shape_name(s.soft_body) +
+        return "Scene('" + s.name + "', tool=" + tool_kind_name(s.tool.kind) + ", soft=" + soft_shape_name(s.soft_bodies.front()) +
                ", method=" + host::to_string(s.simulation.collision_method) + ")";
       });
 

@@ -70,7 +70,7 @@ struct Findings {
 };
 
 void check_soft_body(const host::SceneDescription& scene, Findings& out) {
-  const host::SoftBodyDescription& soft = scene.soft_body;
+  const host::SoftBodyDescription& soft = scene.soft_bodies.front();
   if (const auto* s = std::get_if<host::SoftSphere>(&soft.shape)) {
     out.extent("soft_body.radius_m", s->radius_m);
   } else if (const auto* c = std::get_if<host::SoftCylinder>(&soft.shape)) {
@@ -204,10 +204,10 @@ void require_plausible(const host::SceneDescription& scene) {
 std::string check_settled_on_ground(const Eigen::AlignedBox3d& loaded_bounds_world_m, const Eigen::AlignedBox3d& settled_bounds_world_m,
                                     const host::SceneDescription& scene, double settle_s) {
   // Anchored bodies are tied to the ground and an unsettled one has not fallen yet.
-  if (settle_s <= 0.0 || !scene.soft_body.anchors.empty()) return {};
+  if (settle_s <= 0.0 || !scene.soft_bodies.front().anchors.empty()) return {};
   const double lowest_y = settled_bounds_world_m.min().y();
   const double ground_y = scene.ground.top_height_m;
-  const double tolerance_m = std::max(kSettledBelowGroundTolerance_m, 2.0 * scene.soft_body.collision_margin_m);
+  const double tolerance_m = std::max(kSettledBelowGroundTolerance_m, 2.0 * scene.soft_bodies.front().collision_margin_m);
   const std::string step = "simulation.time_step_s = " + number(scene.simulation.time_step_s) + " s with substeps_count = " +
                            std::to_string(scene.simulation.substeps_count);
   const std::string advice = "use a collision sub-step (time_step_s / substeps_count) of at most " + number(kMaxSettlingSubStep_s) +

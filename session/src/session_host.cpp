@@ -43,7 +43,7 @@ constexpr double kSurfaceVelocityFilter_s = 0.02;
 // weighted by each triangle's contact force and low-passed (kSurfaceVelocityFilter_s). (The share
 // of held nodes that stick is no estimate: a spatula sliding over tissue advances by contact
 // turnover while most held nodes stick for the step — spatula-ball-drag.)
-void add_friction_inputs(const host::HostStepResult& result, const host::ProxyBuilderModel& model, const btSoftBody& soft,
+void add_friction_inputs(const host::HostStepResult& result, const host::ProxyBuilderModel& model, const host::SoftWorld& world,
                          double dt_s, double sub_step_s, std::array<Eigen::Vector3d, 3>& filtered_velocity,
                          host::ProxyPartMotion& parts) {
   std::array<double, 3> weight_n{0.0, 0.0, 0.0};
@@ -54,11 +54,11 @@ void add_friction_inputs(const host::HostStepResult& result, const host::ProxyBu
   }
   for (int i = 0; i < result.contact_count && i < static_cast<int>(result.contacts.size()); ++i) {
     const host::ContactRecord& record = result.contacts[static_cast<std::size_t>(i)];
-    if (record.jaw < 0 || record.jaw >= model.jaw_count || record.soft_face < 0 || record.soft_face >= soft.m_faces.size() ||
-        !(record.force_n > 0.0)) {
+    if (record.jaw < 0 || record.jaw >= model.jaw_count || record.soft_body < 0 || record.soft_body >= world.soft_body_count() ||
+        record.soft_face < 0 || record.soft_face >= world.soft(record.soft_body).m_faces.size() || !(record.force_n > 0.0)) {
       continue;
     }
-    const btSoftBody::Face& face = soft.m_faces[record.soft_face];
+    const btSoftBody::Face& face = world.soft(record.soft_body).m_faces[record.soft_face];
     Eigen::Vector3d v = Eigen::Vector3d::Zero();
     // Over the last sub-step, from positions (m_q: where it started): m_v misses the moves the
     // in-solver contact makes after Bullet's velocity update.
@@ -87,12 +87,28 @@ SessionHost::SessionHost(const host::SceneDescription& scene)
     : scene_(scene), sim_(scene), builder_(session_proxy_model(scene, sim_)) {
   pose_.position_world_m = as_eigen(scene.trajectory.start.position_world_m);
   pose_.orientation_world = to_quaternion(scene.trajectory.start.orientation_world);
-  settled_volume_m3_ = sim_.world().soft().getVolume();
+  take_settled_volumes();
 }
 
 void SessionHost::settle(double seconds) {
   sim_.settle(seconds);
-  settled_volume_m3_ = sim_.world().soft().getVolume();
+  take_settled_volumes();
+}
+
+void SessionHost::take_settled_volumes() {
+  settled_volume_m3_.clear();
+  for (int b = 0; b < sim_.world().soft_body_count(); ++b) settled_volume_m3_.push_back(sim_.world().soft(b).getVolume());
+}
+
+double SessionHost::lowest_volume_ratio() const noexcept {
+  double lowest = std::numeric_limits<double>::infinity();
+  for (int b = 0; b < sim_.world().soft_body_count(); ++b) {
+    const double settled = settled_volume_m3_[static_cast<std::size_t>(b)];
+    const double ratio = settled != 0.0 ? sim_.world().soft(b).getVolume() / settled : std::numeric_limits<double>::quiet_NaN();
+    lowest = std::isnan(ratio) ? ratio : std::min(lowest, ratio);
+    if (std::isnan(lowest)) break;
+  }
+  return lowest;
 }
 
 const HostStatus& SessionHost::step(DeviceStateExchange& state_in, ProxyExchange& proxy_out) {
@@ -151,7 +167,7 @@ const HostStatus& SessionHost::step(DeviceStateExchange& state_in, ProxyExchange
   }
   const host::ProxyBuilderModel& proxy_model = builder_.model();
   if (proxy_model.friction_static_ratio > 0.0) {
-    add_friction_inputs(result, proxy_model, sim_.world().soft(), scene_.simulation.time_step_s,
+    add_friction_inputs(result, proxy_model, sim_.world(), scene_.simulation.time_step_s,
                         scene_.simulation.time_step_s / scene_.simulation.substeps_count, surface_velocity_world_m_per_s_, parts);
   }
   const auto host_time_ns = static_cast<TimeNs>(std::llround(result.time_s * 1e9));
@@ -175,8 +191,7 @@ const HostStatus& SessionHost::step(DeviceStateExchange& state_in, ProxyExchange
   status_.proxy_sequence = proxy_.sequence;
   // A closed surface's signed volume (O(faces), cheap beside the step) goes below 0 when the body
   // is turned inside out; the one-sided collision then meets no triangle and contact silently stops.
-  status_.soft_volume_ratio = settled_volume_m3_ != 0.0 ? sim_.world().soft().getVolume() / settled_volume_m3_
-                                                        : std::numeric_limits<double>::quiet_NaN();
+  status_.soft_volume_ratio = lowest_volume_ratio();
   status_.soft_everted = status_.soft_everted || status_.soft_volume_ratio < 0.0;
   status_.step_cpu_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return status_;

@@ -15,11 +15,11 @@ namespace fissure::host::fixture {
 /// tool swept through it drags the ball instead of knocking it away.
 inline SceneDescription anchored_spatula_sphere() {
   SceneDescription scene = load_scene(resolve_scene_path("spatula-sphere"));
-  const SoftSphere& sphere = std::get<SoftSphere>(scene.soft_body.shape);
+  const SoftSphere& sphere = std::get<SoftSphere>(scene.soft_bodies.front().shape);
   SoftAnchorBox cap;
   cap.min_world_m = {-0.5, 0.0, -0.5};
   cap.max_world_m = {0.5, sphere.center_world_m[1] - sphere.radius_m + 0.01, 0.5};
-  scene.soft_body.anchors.push_back(cap);
+  scene.soft_bodies.front().anchors.push_back(cap);
   return scene;
 }
 

@@ -27,7 +27,7 @@ SceneDescription plate_scene(double thickness_m) {
 // then holds 50 ms; returns the worst crossed-node count seen.
 int plunge_crossed_nodes(double speed_m_s, SceneCollisionMethod method, double shape_matching_ratio = -1.0) {
   SceneDescription scene = plate_scene(0.004);
-  if (shape_matching_ratio >= 0.0) scene.soft_body.shape_matching_ratio = shape_matching_ratio;
+  if (shape_matching_ratio >= 0.0) scene.soft_bodies.front().shape_matching_ratio = shape_matching_ratio;
   HostSimulation sim(scene, method);
   sim.settle(0.3);
   const double dt = sim.scene().simulation.time_step_s;
@@ -90,10 +90,10 @@ TEST(BulletCollision, MeasuredForceBalancesTheSoftBodysMomentum) {
   SceneDescription s = plate_scene(0.004);
   s.ground.top_height_m = -1.0;
   s.tool.box_size_m = {0.2, 0.004, 0.2};
-  s.soft_body.damping_ratio = 0.0;
-  s.soft_body.pressure_kpr = 0.0;
+  s.soft_bodies.front().damping_ratio = 0.0;
+  s.soft_bodies.front().pressure_kpr = 0.0;
   s.trajectory.start.position_world_m = {0.0, 0.02, 0.0};
-  std::get<SoftSphere>(s.soft_body.shape).center_world_m = {0.0, 0.022 + 0.05 + 0.004, 0.0};
+  std::get<SoftSphere>(s.soft_bodies.front().shape).center_world_m = {0.0, 0.022 + 0.05 + 0.004, 0.0};
   HostSimulation sim(s);
   const ToolPose pose = to_tool_pose(s.trajectory.start);
   const btSoftBody& soft = sim.world().soft();

@@ -133,11 +133,11 @@ TEST(HostSimulation, OutOfContactTheCollisionReportsNothing) {
 // triangles add an O(h) ring).
 double held_plate_force_n(int faces) {
   SceneDescription scene = load_scene(resolve_scene_path("spatula-sphere"));
-  SoftSphere sphere = std::get<SoftSphere>(scene.soft_body.shape);
+  SoftSphere sphere = std::get<SoftSphere>(scene.soft_bodies.front().shape);
   sphere.faces_count = faces;
   sphere.tessellation = SphereTessellation::kIcosphere;
-  scene.soft_body.shape = sphere;
-  scene.soft_body.shape_matching_ratio = 0.05;
+  scene.soft_bodies.front().shape = sphere;
+  scene.soft_bodies.front().shape_matching_ratio = 0.05;
   scene.simulation.gravity_world_m_per_s2 = {0.0, 0.0, 0.0};
   scene.tool.box_size_m = {0.1, 0.002, 0.1};
   scene.tool.node_spacing_m = 0.002;

@@ -80,9 +80,9 @@ TEST(SceneLoader, EveryShippedSceneLoads) {
 TEST(SceneLoader, PaperScenesHaveTheirShapes) {
   const SceneDescription spatula = load_scene(resolve_scene_path("spatula-sphere"));
   EXPECT_EQ(spatula.tool.kind, ToolKind::kBox);
-  ASSERT_TRUE(std::holds_alternative<SoftSphere>(spatula.soft_body.shape));
-  EXPECT_EQ(std::get<SoftSphere>(spatula.soft_body.shape).faces_count, 128);
-  EXPECT_DOUBLE_EQ(std::get<SoftSphere>(spatula.soft_body.shape).radius_m, 0.05);
+  ASSERT_TRUE(std::holds_alternative<SoftSphere>(spatula.soft_bodies.front().shape));
+  EXPECT_EQ(std::get<SoftSphere>(spatula.soft_bodies.front().shape).faces_count, 128);
+  EXPECT_DOUBLE_EQ(std::get<SoftSphere>(spatula.soft_bodies.front().shape).radius_m, 0.05);
   EXPECT_EQ(spatula.simulation.collision_method, SceneCollisionMethod::kPaired);
   EXPECT_FALSE(spatula.device_mapping.clamp_mode);
   EXPECT_EQ(spatula.hand.waypoints.size(), 2u);
@@ -98,7 +98,7 @@ TEST(SceneLoader, PaperScenesHaveTheirShapes) {
   EXPECT_EQ(clamp.device_mapping.closing_axis_world, 2);
 
   const SceneDescription vessel = load_scene(resolve_scene_path("clamp-vessel"));
-  EXPECT_TRUE(std::holds_alternative<SoftCylinder>(vessel.soft_body.shape));
+  EXPECT_TRUE(std::holds_alternative<SoftCylinder>(vessel.soft_bodies.front().shape));
 }
 
 TEST(SceneLoader, UnknownKeyNamesFileLineAndField) {
@@ -197,15 +197,15 @@ TEST(SceneLoader, ToolFrictionIsOptionalCheckedAndNeedsTheInSolverResponse) {
 
 TEST(SceneLoader, ShapeMatchingIsOptionalAndRangeChecked) {
   const std::string shipped = read(kScenes / "spatula-sphere.toml");
-  EXPECT_EQ(load_scene_text(shipped, "good.toml", kScenes).soft_body.shape_matching_ratio, 0.05);
+  EXPECT_EQ(load_scene_text(shipped, "good.toml", kScenes).soft_bodies.front().shape_matching_ratio, 0.05);
   // Without the (optional) key: its line, comment and all, removed.
   const std::size_t key = shipped.find("shape_matching_ratio");
   ASSERT_NE(key, std::string::npos);
   const std::size_t next_key = shipped.find("damping_ratio", key);
   const std::string good = shipped.substr(0, key) + shipped.substr(next_key);
-  EXPECT_EQ(load_scene_text(good, "good.toml", kScenes).soft_body.shape_matching_ratio, 0.0);
+  EXPECT_EQ(load_scene_text(good, "good.toml", kScenes).soft_bodies.front().shape_matching_ratio, 0.0);
   const std::string with = replace(good, "damping_ratio = 0.02", "damping_ratio = 0.02\nshape_matching_ratio = 0.05");
-  EXPECT_EQ(load_scene_text(with, "good.toml", kScenes).soft_body.shape_matching_ratio, 0.05);
+  EXPECT_EQ(load_scene_text(with, "good.toml", kScenes).soft_bodies.front().shape_matching_ratio, 0.05);
   const std::string bad = replace(good, "damping_ratio = 0.02", "damping_ratio = 0.02\nshape_matching_ratio = 1.5");
   expect_error(load_error(bad), line_of(bad, "shape_matching_ratio"), "soft_body.shape_matching_ratio", "must be in");
 }
@@ -217,12 +217,12 @@ std::string with_anchor(const std::string& shipped, const std::string& anchor_bo
 
 TEST(SceneLoader, AnchorsAreOptionalAndRead) {
   const std::string shipped = read(kScenes / "spatula-sphere.toml");
-  EXPECT_TRUE(load_scene_text(shipped, "good.toml", kScenes).soft_body.anchors.empty());
+  EXPECT_TRUE(load_scene_text(shipped, "good.toml", kScenes).soft_bodies.front().anchors.empty());
   const std::string good = with_anchor(shipped, "min_world_m = [-0.1, -0.01, -0.1]\nmax_world_m = [0.1, 0.012, 0.1]");
   const SceneDescription scene = load_scene_text(good, "good.toml", kScenes);
-  ASSERT_EQ(scene.soft_body.anchors.size(), 1u);
-  EXPECT_EQ(scene.soft_body.anchors[0].min_world_m[1], -0.01);
-  EXPECT_EQ(scene.soft_body.anchors[0].max_world_m[1], 0.012);
+  ASSERT_EQ(scene.soft_bodies.front().anchors.size(), 1u);
+  EXPECT_EQ(scene.soft_bodies.front().anchors[0].min_world_m[1], -0.01);
+  EXPECT_EQ(scene.soft_bodies.front().anchors[0].max_world_m[1], 0.012);
 }
 
 TEST(SceneLoader, MalformedAnchorsNameFileLineAndField) {
@@ -378,17 +378,17 @@ const std::string kLiver = "youngs_modulus_pa = 7000.0\npoisson_ratio = 0.45\nde
 
 TEST_F(FemSceneLoader, ReadsTheSiMaterialAndTheMassFromDensityAndVolume) {
   const SceneDescription scene = load_scene_text(fem_scene(kLiver + "elasticity = \"neo_hookean\"\nmass_damping_per_s = 5.0\n"), "good.toml", kScenes);
-  EXPECT_EQ(scene.soft_body.model, SoftBodyModel::kFem);
-  EXPECT_EQ(scene.soft_body.fem.model, FemModel::kNeoHookean);
-  EXPECT_EQ(scene.soft_body.fem.youngs_modulus_pa, 7000.0);
-  EXPECT_EQ(scene.soft_body.fem.poisson_ratio, 0.45);
-  EXPECT_EQ(scene.soft_body.fem.density_kg_per_m3, 1040.0);
-  EXPECT_EQ(scene.soft_body.fem.mass_damping_per_s, 5.0);
-  EXPECT_EQ(scene.soft_body.fem.stiffness_damping_s, 0.0);
-  EXPECT_NEAR(scene.soft_body.mass_kg, 1040.0 * 0.02 * 0.01 * 0.02, 1e-12);
+  EXPECT_EQ(scene.soft_bodies.front().model, SoftBodyModel::kFem);
+  EXPECT_EQ(scene.soft_bodies.front().fem.model, FemModel::kNeoHookean);
+  EXPECT_EQ(scene.soft_bodies.front().fem.youngs_modulus_pa, 7000.0);
+  EXPECT_EQ(scene.soft_bodies.front().fem.poisson_ratio, 0.45);
+  EXPECT_EQ(scene.soft_bodies.front().fem.density_kg_per_m3, 1040.0);
+  EXPECT_EQ(scene.soft_bodies.front().fem.mass_damping_per_s, 5.0);
+  EXPECT_EQ(scene.soft_bodies.front().fem.stiffness_damping_s, 0.0);
+  EXPECT_NEAR(scene.soft_bodies.front().mass_kg, 1040.0 * 0.02 * 0.01 * 0.02, 1e-12);
   // The defaults: a shell unless told otherwise, corotated linear elasticity.
-  EXPECT_EQ(load_scene_text(shell_, "good.toml", kScenes).soft_body.model, SoftBodyModel::kShell);
-  EXPECT_EQ(load_scene_text(fem_scene(kLiver), "good.toml", kScenes).soft_body.fem.model, FemModel::kCorotatedLinear);
+  EXPECT_EQ(load_scene_text(shell_, "good.toml", kScenes).soft_bodies.front().model, SoftBodyModel::kShell);
+  EXPECT_EQ(load_scene_text(fem_scene(kLiver), "good.toml", kScenes).soft_bodies.front().fem.model, FemModel::kCorotatedLinear);
 }
 
 TEST_F(FemSceneLoader, OutOfRangeMaterialNamesFileLineFieldValueAndRange) {

@@ -82,7 +82,7 @@ PushResult push_sideways(HostSimulation& sim, double push_m) {
 
 TEST(SoftBodyAnchor, SelectsTheRestNodesInsideTheBox) {
   SceneDescription scene = sphere_scene();
-  const std::vector<Vec3> rest = soft_body_rest_nodes_world_m(scene.soft_body);
+  const std::vector<Vec3> rest = soft_body_rest_nodes_world_m(scene.soft_bodies.front());
   ASSERT_EQ(rest.size(), 66u);  // CreateEllipsoid(res 63): 66 nodes, 128 faces
   const std::vector<int> cap = nodes_in_anchor_box(rest, bottom_cap());
   ASSERT_FALSE(cap.empty());
@@ -90,7 +90,7 @@ TEST(SoftBodyAnchor, SelectsTheRestNodesInsideTheBox) {
     const bool selected = std::find(cap.begin(), cap.end(), static_cast<int>(i)) != cap.end();
     EXPECT_EQ(selected, rest[i][1] <= 0.012) << "node " << i << " at y = " << rest[i][1];
   }
-  scene.soft_body.anchors.push_back(bottom_cap());
+  scene.soft_bodies.front().anchors.push_back(bottom_cap());
   SoftWorld world(scene, false);
   EXPECT_EQ(world.anchored_nodes_count(), static_cast<int>(cap.size()));
   EXPECT_EQ(world.soft().m_anchors.size(), static_cast<int>(cap.size()));
@@ -101,8 +101,8 @@ TEST(SoftBodyAnchor, SelectsTheRestNodesInsideTheBox) {
 
 TEST(SoftBodyAnchor, BoxSelectingNothingIsRefusedByName) {
   SceneDescription scene = sphere_scene();
-  scene.soft_body.anchors.push_back(bottom_cap());
-  scene.soft_body.anchors.push_back({{0.2, 0.2, 0.2}, {0.3, 0.3, 0.3}});
+  scene.soft_bodies.front().anchors.push_back(bottom_cap());
+  scene.soft_bodies.front().anchors.push_back({{0.2, 0.2, 0.2}, {0.3, 0.3, 0.3}});
   try {
     SoftWorld world(scene, false);
     FAIL() << "an anchor box with no node in it was accepted";
@@ -122,7 +122,7 @@ TEST(SoftBodyAnchor, AnchoredBallStaysWhereTheFreeBallIsPushedAway) {
   constexpr double kPush_m = 0.08;  // 1 cm to first touch, then 7 cm
   SceneDescription free_scene = sphere_scene();
   SceneDescription anchored_scene = free_scene;
-  anchored_scene.soft_body.anchors.push_back(bottom_cap());
+  anchored_scene.soft_bodies.front().anchors.push_back(bottom_cap());
   HostSimulation free_sim(free_scene);
   HostSimulation anchored_sim(anchored_scene);
   const PushResult free_push = push_sideways(free_sim, kPush_m);
@@ -146,11 +146,11 @@ TEST(SoftBodyAnchor, AnchoredBallStaysWhereTheFreeBallIsPushedAway) {
 // mass), and Bullet's anchors pull them back to their rest place once the plate has gone.
 TEST(SoftBodyAnchor, AnchoredNodesDisplacedByTheToolReturn) {
   SceneDescription scene = sphere_scene();
-  scene.soft_body.anchors.push_back(bottom_cap());
+  scene.soft_bodies.front().anchors.push_back(bottom_cap());
   // The ball's left side (x ≤ −4 cm), where the plate presses in.
   const SoftAnchorBox side{{-0.1, 0.03, -0.03}, {-0.04, 0.075, 0.03}};
-  scene.soft_body.anchors.push_back(side);
-  const std::vector<int> side_nodes = nodes_in_anchor_box(soft_body_rest_nodes_world_m(scene.soft_body), side);
+  scene.soft_bodies.front().anchors.push_back(side);
+  const std::vector<int> side_nodes = nodes_in_anchor_box(soft_body_rest_nodes_world_m(scene.soft_bodies.front()), side);
   ASSERT_GE(side_nodes.size(), 2u);
   HostSimulation sim(scene);
   const PushResult push = push_sideways(sim, 0.02);  // 1 cm past first touch

@@ -70,12 +70,12 @@ TEST(SoftBodyMesh, CreateFromTriMeshReplicaBuildsBulletsBody) {
 
 TEST(SoftBodyMesh, ShippedLobeIsAClosedNonConvexSurfaceBuiltWithLinksOnItsEdges) {
   const SceneDescription scene = load_scene(kScenes / "spatula-blob.toml");
-  const auto* mesh = std::get_if<SoftMesh>(&scene.soft_body.shape);
+  const auto* mesh = std::get_if<SoftMesh>(&scene.soft_bodies.front().shape);
   ASSERT_NE(mesh, nullptr);
   EXPECT_EQ(mesh->triangles.size(), 1280U);
   EXPECT_LT(mesh->triangles.size(), 2000U);
   btSoftBodyWorldInfo info;
-  const std::unique_ptr<btSoftBody> body(build_soft_body(info, scene.soft_body));
+  const std::unique_ptr<btSoftBody> body(build_soft_body(info, scene.soft_bodies.front()));
   ASSERT_EQ(body->m_nodes.size(), static_cast<int>(mesh->vertices_world_m.size()));
   EXPECT_EQ(body->m_faces.size(), 1280);
   EXPECT_EQ(body->m_links.size(), 1280 * 3 / 2) << "one link per edge of the closed surface";
@@ -89,10 +89,10 @@ TEST(SoftBodyMesh, ShippedLobeIsAClosedNonConvexSurfaceBuiltWithLinksOnItsEdges)
   }
   // The sphere scenes' material and pose matching (spatula-sphere.toml).
   const SceneDescription sphere = load_scene(kScenes / "spatula-sphere.toml");
-  EXPECT_EQ(scene.soft_body.shape_matching_ratio, sphere.soft_body.shape_matching_ratio);
-  EXPECT_EQ(scene.soft_body.linear_stiffness_ratio, sphere.soft_body.linear_stiffness_ratio);
-  EXPECT_FLOAT_EQ(body->m_cfg.kMT, static_cast<float>(sphere.soft_body.shape_matching_ratio));
-  EXPECT_FLOAT_EQ(body->m_materials[0]->m_kLST, static_cast<float>(sphere.soft_body.linear_stiffness_ratio));
+  EXPECT_EQ(scene.soft_bodies.front().shape_matching_ratio, sphere.soft_bodies.front().shape_matching_ratio);
+  EXPECT_EQ(scene.soft_bodies.front().linear_stiffness_ratio, sphere.soft_bodies.front().linear_stiffness_ratio);
+  EXPECT_FLOAT_EQ(body->m_cfg.kMT, static_cast<float>(sphere.soft_bodies.front().shape_matching_ratio));
+  EXPECT_FLOAT_EQ(body->m_materials[0]->m_kLST, static_cast<float>(sphere.soft_bodies.front().linear_stiffness_ratio));
   EXPECT_TRUE(body->m_pose.m_bframe) << "setPose recorded the rest shape for pose matching";
   double lowest = 1.0;
   for (const Vec3& v : mesh->vertices_world_m) lowest = std::min(lowest, v[1]);
@@ -228,7 +228,7 @@ TEST(SoftBodyTetMesh, SceneWithATetGenMeshSettlesFinite) {
   replace_line("offset_world_m", "offset_world_m = [-0.02, 0.002, -0.02]");  // 40 × 20 × 40 mm, 2 mm (the soft margin) above the ground
   std::ofstream(dir / "scene.toml") << text;
   const SceneDescription scene = load_scene(dir / "scene.toml");
-  const auto* mesh = std::get_if<SoftMesh>(&scene.soft_body.shape);
+  const auto* mesh = std::get_if<SoftMesh>(&scene.soft_bodies.front().shape);
   ASSERT_NE(mesh, nullptr);
   EXPECT_EQ(mesh->tetrahedra.size(), 6U * 32U);
   EXPECT_EQ(mesh->triangles.size(), 4U * (4 * 2 + 2 * 4 + 4 * 4)) << "the box's boundary";
@@ -238,7 +238,7 @@ TEST(SoftBodyTetMesh, SceneWithATetGenMeshSettlesFinite) {
   EXPECT_EQ(body.m_tetras.size(), 6 * 32);
   double total_kg = 0.0;
   for (int i = 0; i < body.m_nodes.size(); ++i) total_kg += 1.0 / body.m_nodes[i].m_im;
-  EXPECT_NEAR(total_kg, scene.soft_body.mass_kg, 1e-6 * scene.soft_body.mass_kg) << "the scene's mass, spread by volume";
+  EXPECT_NEAR(total_kg, scene.soft_bodies.front().mass_kg, 1e-6 * scene.soft_bodies.front().mass_kg) << "the scene's mass, spread by volume";
   for (int step = 0; step < 500; ++step) world.step(scene.simulation.time_step_s);
   std::vector<Eigen::Vector3d> nodes;
   world.copy_node_positions(nodes);
@@ -249,7 +249,7 @@ TEST(SoftBodyTetMesh, SceneWithATetGenMeshSettlesFinite) {
     highest_m = std::max(highest_m, p.y());
   }
   // Resting on the ground within its margin, neither fallen through nor blown up.
-  EXPECT_GT(lowest_m, -scene.soft_body.collision_margin_m);
+  EXPECT_GT(lowest_m, -scene.soft_bodies.front().collision_margin_m);
   EXPECT_LT(highest_m, 0.022 + 0.002);
   EXPECT_GT(highest_m, 0.005) << "still a body, not a puddle";
 }

@@ -114,10 +114,10 @@ TEST(SoftWorld, ClampJawsSitEitherSideOfTheGap) {
 TEST(SoftWorld, VesselAndSlabBuild) {
   const SceneDescription vessel = load_scene("scenes/clamp-vessel.toml");
   SoftWorld world(vessel, false);
-  const SoftCylinder& c = std::get<SoftCylinder>(vessel.soft_body.shape);
+  const SoftCylinder& c = std::get<SoftCylinder>(vessel.soft_bodies.front().shape);
   EXPECT_EQ(world.soft().m_nodes.size(), c.segments_count * c.rings_count + 2);
   SceneDescription slab = vessel;
-  slab.soft_body.shape = SoftSlab{};
+  slab.soft_bodies.front().shape = SoftSlab{};
   SoftWorld slab_world(slab, false);
   int pinned = 0;
   for (int i = 0; i < slab_world.soft().m_nodes.size(); ++i) pinned += slab_world.soft().m_nodes[i].m_im == 0 ? 1 : 0;

@@ -37,7 +37,7 @@ TEST(ScenePlausibility, TheShippedScenesArePlausible) {
 
 TEST(ScenePlausibility, ARadiusInMetresThatWasMeantInMillimetresIsNamed) {
   host::SceneDescription scene = spatula_sphere();
-  std::get<host::SoftSphere>(scene.soft_body.shape).radius_m = 50.0;
+  std::get<host::SoftSphere>(scene.soft_bodies.front().shape).radius_m = 50.0;
   const ImplausibleValue f = only_finding(scene);
   EXPECT_EQ(f.field, "soft_body.radius_m");
   EXPECT_EQ(f.value, "50 m");
@@ -49,7 +49,7 @@ TEST(ScenePlausibility, GravityMassHuntCrossleyAndGripOutOfAnyBenchAreNamed) {
   scene.simulation.gravity_world_m_per_s2 = {0.0, -1e9, 0.0};
   EXPECT_EQ(only_finding(scene).field, "simulation.gravity_world_m_per_s2");
   scene = spatula_sphere();
-  scene.soft_body.mass_kg = 1e9;
+  scene.soft_bodies.front().mass_kg = 1e9;
   EXPECT_EQ(only_finding(scene).field, "soft_body.mass_kg");
   scene = spatula_sphere();
   scene.hunt_crossley.k = 1e30;

@@ -113,7 +113,7 @@ TEST_F(SessionRunnerTest, ABallThatFallsThroughTheGroundWhileSettlingIsRefusedNa
 
 TEST_F(SessionRunnerTest, NonFiniteFiguresFailTheRunNamingTheQuantityAndWriteNothing) {
   write_earlier_outputs();
-  std::get<host::SoftSphere>(options_.scene.soft_body.shape).radius_m = 1e6;
+  std::get<host::SoftSphere>(options_.scene.soft_bodies.front().shape).radius_m = 1e6;
   const std::string error = refusal();
   EXPECT_NE(error.find("non-finite"), std::string::npos) << error;
   // The quantity and when: the nodes while settling, or a trace quantity at its tick.

@@ -56,14 +56,9 @@ RenderModel make_render_model(host::HostSimulation& sim) {
   }
   RenderModel model;
   model.scene_name = scene.name;
-  const btSoftBody& soft = sim.world().soft();
-  const btSoftBody::Node* first = &soft.m_nodes[0];
-  model.soft_triangles.reserve(static_cast<std::size_t>(soft.m_faces.size()));
-  for (int f = 0; f < soft.m_faces.size(); ++f) {
-    const btSoftBody::Face& face = soft.m_faces[f];
-    model.soft_triangles.push_back({static_cast<int>(face.m_n[0] - first), static_cast<int>(face.m_n[1] - first),
-                                    static_cast<int>(face.m_n[2] - first)});
-  }
+  model.soft_triangles = sim.soft_faces();
+  model.soft_body_first_node.clear();
+  for (int b = 0; b <= sim.soft_body_count(); ++b) model.soft_body_first_node.push_back(sim.first_node(b));
   model.soft_rest_world_m.reserve(nodes.size());
   for (const Eigen::Vector3d& p : nodes) model.soft_rest_world_m.push_back(p.cast<float>());
 
@@ -91,18 +86,23 @@ RenderModel make_render_model(host::HostSimulation& sim) {
 }
 
 RigidMotion fit_rigid_motion(const RenderModel& model, const Eigen::Vector3f* nodes_world_m, std::size_t count) noexcept {
+  return fit_rigid_motion(model, nodes_world_m, 0, count);
+}
+
+RigidMotion fit_rigid_motion(const RenderModel& model, const Eigen::Vector3f* nodes_world_m, std::size_t first, std::size_t end) noexcept {
   RigidMotion motion;
-  const std::size_t n = std::min(count, model.soft_rest_world_m.size());
-  if (n < 3) return motion;
+  end = std::min(end, model.soft_rest_world_m.size());
+  if (end < first + 3) return motion;
+  const std::size_t n = end - first;
   Eigen::Vector3d rest_centre = Eigen::Vector3d::Zero(), centre = Eigen::Vector3d::Zero();
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = first; i < end; ++i) {
     rest_centre += model.soft_rest_world_m[i].cast<double>();
     centre += nodes_world_m[i].cast<double>();
   }
   rest_centre /= static_cast<double>(n);
   centre /= static_cast<double>(n);
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = first; i < end; ++i) {
     covariance += (nodes_world_m[i].cast<double>() - centre) * (model.soft_rest_world_m[i].cast<double>() - rest_centre).transpose();
   }
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(covariance, Eigen::ComputeFullU | Eigen::ComputeFullV);

@@ -203,9 +203,18 @@ void SceneRenderer::add_soft_body(const RenderSnapshot& snapshot) {
     const Eigen::Vector3f face = (soft_positions_[static_cast<std::size_t>(tri[1])] - a).cross(soft_positions_[static_cast<std::size_t>(tri[2])] - a);
     for (int k = 0; k < 3; ++k) soft_normals_[static_cast<std::size_t>(tri[static_cast<std::size_t>(k)])] += face;
   }
-  const RigidMotion motion = fit_rigid_motion(model_, soft_positions_.data(), static_cast<std::size_t>(n));
+  // Each body's rigid motion; a triangle's three nodes belong to one body.
+  const std::size_t bodies = model_.soft_body_first_node.size() - 1;
+  soft_motions_.resize(bodies);
+  for (std::size_t b = 0; b < bodies; ++b) {
+    soft_motions_[b] = fit_rigid_motion(model_, soft_positions_.data(), static_cast<std::size_t>(model_.soft_body_first_node[b]),
+                                        static_cast<std::size_t>(std::min(n, model_.soft_body_first_node[b + 1])));
+  }
   for (const auto& tri : model_.soft_triangles) {
     if (tri[0] >= n || tri[1] >= n || tri[2] >= n) continue;
+    const auto body = static_cast<std::size_t>(
+        std::upper_bound(model_.soft_body_first_node.begin() + 1, model_.soft_body_first_node.end() - 1, tri[0]) - (model_.soft_body_first_node.begin() + 1));
+    const RigidMotion& motion = soft_motions_[body];
     for (int k = 0; k < 3; ++k) {
       const auto i = static_cast<std::size_t>(tri[static_cast<std::size_t>(k)]);
       const Eigen::Vector3f& p = soft_positions_[i];

@@ -1,7 +1,7 @@
 #pragma once
 // HostSimulation: one scene's host side. Owns the Bullet world (SoftWorld), the chosen
-// thin-body collision (one instance per collidable tool part: the spatula, or each clamp
-// jaw), and the method-independent metrics. Each step(): move the tool (and jaws) to the
+// thin-body collision (one instance per soft body and collidable tool part: the spatula, or each
+// clamp jaw), and the method-independent metrics. Each step(): move the tool (and jaws) to the
 // target over the scene's sub-steps, one Bullet step + one collision step + the metrics per
 // sub-step (the crossing metric judges each node's straight relative path between two updates). Everything is preallocated at construction; step() does not allocate.
 //
@@ -38,7 +38,7 @@ struct HostStepResult {
   std::vector<ContactRecord> contacts;                   ///< all parts (last sub-step); capacity reserved once
   int contact_count = 0;
   CrossingSnapshot crossing;                             ///< summed over parts, the step's worst sub-step (rim passes: all); penetration = max
-  std::array<CollisionStepResult, kMaxToolParts> part_results;  ///< the method's own report per part
+  std::array<CollisionStepResult, kMaxToolParts> part_results;  ///< the method's own report per part (summed over the soft bodies)
   HostStepTimes times;
   double jaw_gap_m = 0.0;                                ///< clamp: the gap actually applied
 };
@@ -89,10 +89,20 @@ class HostSimulation {
   [[nodiscard]] double time_s() const noexcept { return time_s_; }
   [[nodiscard]] const HostStepResult& last() const noexcept { return result_; }
   [[nodiscard]] SoftWorld& world() noexcept { return *world_; }
+  [[nodiscard]] const SoftWorld& world() const noexcept { return *world_; }
   [[nodiscard]] const std::vector<Eigen::Vector3d>& node_positions_world_m() const noexcept { return nodes_; }
   /// The collision model of part p (nullptr for the bullet method).
   [[nodiscard]] const ToolNodes* tool_nodes(int part) const noexcept;
+  /// Soft triangles and nodes over every body; node_positions_world_m() and soft_faces() hold them
+  /// body after body (first_node).
   [[nodiscard]] int soft_face_count() const noexcept;
+  [[nodiscard]] int soft_body_count() const noexcept { return world_->soft_body_count(); }
+  /// Where body `body`'s nodes start in node_positions_world_m() (soft_body_count(): the total).
+  [[nodiscard]] int first_node(int body) const noexcept { return world_->first_node(body); }
+  /// Where body `body`'s triangles start in soft_faces() (soft_body_count(): the total).
+  [[nodiscard]] int first_face(int body) const noexcept { return first_faces_[static_cast<std::size_t>(body)]; }
+  /// Every body's triangles as indices into node_positions_world_m().
+  [[nodiscard]] const std::vector<std::array<int, 3>>& soft_faces() const noexcept { return soft_faces_; }
   /// Soft triangles cut by the tool's interior now (triangles_cut_by_volume with the metrics'
   /// tool volume, summed over the parts): the failure the crossed count cannot see. Diagnostic
   /// cost; not part of step().
@@ -111,9 +121,13 @@ class HostSimulation {
   SceneCollisionMethod method_;
   std::unique_ptr<SoftWorld> world_;
   std::vector<ToolNodes> tool_nodes_;  // per part (paired/ray)
-  std::array<std::unique_ptr<ThinBodyCollision>, kMaxToolParts> collisions_;
+  // One per soft body and part: collisions_[body · part_count + part].
+  std::vector<std::unique_ptr<ThinBodyCollision>> collisions_;
+  // Several bodies: each collision's report before they are summed into the part's.
+  std::vector<CollisionStepResult> body_part_results_;
   std::vector<CrossingTracker> trackers_;
   std::vector<std::array<int, 3>> soft_faces_;  // node indices of each soft face (fixed topology; triangles_cut_by_tool)
+  std::vector<int> first_faces_;  // per body, and the total last
   std::vector<Eigen::Vector3d> nodes_;
   ToolPose tool_pose_;
   double jaw_gap_m_ = 0.0;

@@ -17,6 +17,7 @@
 // the same solvers run in the same order on the same data; only the no-op cluster passes move
 // relative to the position iterations, and the solver falls back to the stock path (bounds
 // invalid) for a body whose solve it cannot reproduce that way (clusters, drift iterations).
+#include <memory>
 #include <vector>
 
 #include <BulletSoftBody/btDefaultSoftBodySolver.h>
@@ -72,25 +73,36 @@ class SoftContactConstraint {
 
 class NodeBoundsSolver : public btDefaultSoftBodySolver {
  public:
-  // Keep bounds for this body (one per solver; other bodies get Bullet's stock solve).
-  void attach(btSoftBody* soft);
-  [[nodiscard]] SoftNodeBounds& bounds() noexcept { return bounds_; }
-  // Solve `contact` with the attached body, in the order added (a clamp: one per jaw). Not owned:
-  // it must outlive the solver or be removed by clear_contacts().
-  void add_contact(SoftContactConstraint* contact) { contacts_.push_back(contact); }
-  void clear_contacts() noexcept { contacts_.clear(); }
+  NodeBoundsSolver() = default;
+  NodeBoundsSolver(const NodeBoundsSolver&) = delete;
+  NodeBoundsSolver& operator=(const NodeBoundsSolver&) = delete;
+  ~NodeBoundsSolver() override;
+
+  // Keep bounds for this body and solve its contacts; returns its index for bounds() and
+  // add_contact() (a scene's bodies in their order). A body not attached gets Bullet's stock solve.
+  int attach(btSoftBody* soft);
+  [[nodiscard]] int attached_count() const noexcept { return static_cast<int>(bodies_.size()); }
+  // The bounds of attached body `body` (stable address: the collisions keep a pointer).
+  [[nodiscard]] SoftNodeBounds& bounds(int body = 0) noexcept { return bodies_[static_cast<std::size_t>(body)]->bounds; }
+  // Solve `contact` with attached body `body`, in the order added (a clamp: one per jaw). Not
+  // owned: it must outlive the solver or be removed by clear_contacts().
+  void add_contact(SoftContactConstraint* contact, int body = 0) { bodies_[static_cast<std::size_t>(body)]->contacts.push_back(contact); }
+  void clear_contacts() noexcept;
 
   void solveConstraints(btScalar solver_dt) override;
 
  private:
-  void solve_with_bounds(btSoftBody& soft);
+  struct AttachedBody {
+    btSoftBody* soft = nullptr;
+    SoftNodeBounds bounds;
+    std::vector<SoftContactConstraint*> contacts;
+  };
+  void solve_with_bounds(AttachedBody& body);
   // The bounds of every node's m_q and m_x; with `velocity_update` Bullet's velocity update is
   // fused into the same pass (node_bounds_solver.cpp).
-  void take_bounds(btSoftBody& soft, bool velocity_update);
+  static void take_bounds(btSoftBody& soft, SoftNodeBounds& bounds, bool velocity_update);
 
-  btSoftBody* soft_ = nullptr;
-  SoftNodeBounds bounds_;
-  std::vector<SoftContactConstraint*> contacts_;
+  std::vector<std::unique_ptr<AttachedBody>> bodies_;
 };
 
 }  // namespace fissure::host

@@ -216,13 +216,22 @@ struct TrajectoryDescription {
   std::vector<TrajectoryWaypoint> waypoints;
 };
 
+/// The most soft bodies a scene may hold: Bullet tests every pair of bodies for soft–soft contact
+/// each step, and the host step carries one thin-body collision per body and tool part; eight
+/// covers a fissure's two lobes with the vessels and membranes around them.
+inline constexpr int kMaxSoftBodies = 8;
+
 struct SceneDescription {
   std::string name;                 ///< scene name (file stem)
   std::string source_path;          ///< the file it came from ("" when built in code)
   std::string description;
   SimulationDescription simulation{};
   GroundDescription ground{};
-  SoftBodyDescription soft_body{};
+  /// [soft_body] (one body) or [[soft_body]] (several, each with its anchors): never empty. The
+  /// first is the body the benchmarks and the single-body figures study; the tool meets every
+  /// body through the thin-body collision, and the bodies meet each other through Bullet's
+  /// vertex–face soft–soft collision (soft_world.hpp).
+  std::vector<SoftBodyDescription> soft_bodies{SoftBodyDescription{}};
   ToolDescription tool{};
   HuntCrossleyParams hunt_crossley{};
   DeviceMapping device_mapping{};

@@ -1,9 +1,11 @@
 #pragma once
-// The Bullet world of a scene: btSoftRigidDynamicsWorld, box ground, the soft body, and the
+// The Bullet world of a scene: btSoftRigidDynamicsWorld, box ground, the soft bodies, and the
 // tool's kinematic rigid bodies (one per collidable part: the spatula, or the clamp's two
 // jaws; the clamp handle never collides and has no body). The tool bodies collide with the
 // soft body through Bullet ONLY for the `bullet` method; for paired/ray they are not in the
 // world at all (thin_body_collision.hpp's call order) and the soft body meets just the ground.
+// Several soft bodies meet each other through Bullet's vertex–face soft–soft contact (VF_SS:
+// each body's nodes against the other's faces, solved in its position iterations).
 //
 // Bullet set-up (BRIEF §3): for the `bullet` method the sparse SDF's voxel is set to half the
 // tool's thinnest extent AFTER Initialize() (which forces 0.25 m), then Reset(), and the tool
@@ -59,8 +61,12 @@ class SoftWorld {
   SoftWorld& operator=(const SoftWorld&) = delete;
 
   [[nodiscard]] btSoftRigidDynamicsWorld& world() noexcept { return *world_; }
-  [[nodiscard]] btSoftBody& soft() noexcept { return *soft_; }
-  [[nodiscard]] const btSoftBody& soft() const noexcept { return *soft_; }
+  /// Soft body `body` of the scene's [[soft_body]] list (0: the first, the only one of most scenes).
+  [[nodiscard]] btSoftBody& soft(int body = 0) noexcept { return *softs_[static_cast<std::size_t>(body)]; }
+  [[nodiscard]] const btSoftBody& soft(int body = 0) const noexcept { return *softs_[static_cast<std::size_t>(body)]; }
+  [[nodiscard]] int soft_body_count() const noexcept { return static_cast<int>(softs_.size()); }
+  /// Where body `body`'s nodes start in copy_node_positions' concatenation (body_count: the total).
+  [[nodiscard]] int first_node(int body) const noexcept { return first_nodes_[static_cast<std::size_t>(body)]; }
   [[nodiscard]] int part_count() const noexcept { return geometry_.part_count; }
   [[nodiscard]] const ToolPartGeometry& geometry() const noexcept { return geometry_; }
   /// The part's rigid body (kinematic; in the world only when the tool collides in Bullet).
@@ -68,11 +74,11 @@ class SoftWorld {
   /// Non-null only when the tool collides in Bullet.
   [[nodiscard]] ContactProbeSolver* probe() noexcept { return probe_; }
   /// Non-null only when the tool does not collide in Bullet (and the solver is not the stock one).
-  [[nodiscard]] SoftNodeBounds* node_bounds() noexcept { return bounding_solver_ != nullptr ? &bounding_solver_->bounds() : nullptr; }
+  [[nodiscard]] SoftNodeBounds* node_bounds(int body = 0) noexcept { return bounding_solver_ != nullptr ? &bounding_solver_->bounds(body) : nullptr; }
   /// The solver behind node_bounds() (it also solves the in-solver contacts); null as above.
   [[nodiscard]] NodeBoundsSolver* node_bounds_solver() noexcept { return bounding_solver_; }
   [[nodiscard]] double sdf_voxel_m() const noexcept { return sdf_voxel_m_; }
-  /// Soft nodes tied to the ground by [[soft_body.anchor]] (0: a free body).
+  /// Soft nodes tied to the ground by [[soft_body.anchor]], over every body (0: free bodies).
   [[nodiscard]] int anchored_nodes_count() const noexcept { return anchored_nodes_count_; }
 
   /// Places a tool part (kinematic: Bullet derives its velocity from the previous pose).
@@ -83,7 +89,8 @@ class SoftWorld {
   void teleport_part(int part, const ToolPose& pose) noexcept;
   /// One Bullet step of h seconds (exactly one internal substep).
   void step(double h_s) noexcept;
-  /// Copies the soft nodes' positions (world, metres) into `out` (resized once).
+  /// Copies every soft body's node positions (world, metres), body after body (first_node), into
+  /// `out` (resized once).
   void copy_node_positions(std::vector<Eigen::Vector3d>& out) const;
 
  private:
@@ -101,7 +108,8 @@ class SoftWorld {
   std::vector<std::unique_ptr<btDefaultMotionState>> motion_states_;
   std::unique_ptr<btRigidBody> ground_;
   std::array<std::unique_ptr<btRigidBody>, kMaxToolParts> parts_;
-  std::unique_ptr<btSoftBody> soft_;
+  std::vector<std::unique_ptr<btSoftBody>> softs_;
+  std::vector<int> first_nodes_;  // per body, and the total last
   bool parts_in_world_ = false;
   int anchored_nodes_count_ = 0;
 };

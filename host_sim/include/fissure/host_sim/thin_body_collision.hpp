@@ -88,6 +88,7 @@ struct ContactRecord {
                                       // area × (Σ colliding-vertex shares s_v / 3; centroid_distance:
                                       // s_v = 1); per-triangle mode: the same without the area
   double force_n = 0.0;               // this triangle's HC force magnitude (≥ 0)
+  int soft_body = 0;                  // which of the scene's soft bodies soft_face belongs to (HostSimulation sets it)
 };
 
 struct CollisionStepResult {

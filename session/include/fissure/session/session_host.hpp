@@ -6,6 +6,7 @@
 // time, or interleaved with the rt ticks in lockstep.
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include "fissure/host_sim/host_simulation.hpp"
 #include "fissure/host_sim/proxy_builder.hpp"
@@ -36,7 +37,8 @@ struct HostStatus {
   std::uint64_t rejected_device_states = 0;  ///< non-finite samples dropped before the scene
   std::uint64_t tool_reseats = 0;     ///< device position epoch changes: tool re-seated, not swept
   /// Soft body's signed enclosed volume / its volume when settled (1 at rest; < 0: more of its
-  /// surface faces inwards than outwards — turned inside out; meaningful for a closed surface only).
+  /// surface faces inwards than outwards — turned inside out; meaningful for a closed surface only);
+  /// with several bodies, the lowest of theirs.
   double soft_volume_ratio = 1.0;
   bool soft_everted = false;          ///< soft_volume_ratio < 0 after some step so far (latched)
 };
@@ -60,6 +62,9 @@ class SessionHost {
   [[nodiscard]] double time_step_s() const noexcept { return scene_.simulation.time_step_s; }
 
  private:
+  void take_settled_volumes();
+  /// The lowest of the bodies' volume / settled volume (NaN when a settled volume is 0).
+  [[nodiscard]] double lowest_volume_ratio() const noexcept;
   const host::SceneDescription& scene_;
   host::HostSimulation sim_;
   host::ProxyBuilder builder_;
@@ -69,7 +74,7 @@ class SessionHost {
   /// The device position epoch the tool pose follows (messages.hpp; 0: none yet — the tool
   /// stays at the scene's start pose until rt_core has accepted a sample).
   std::uint8_t applied_epoch_ = 0;
-  double settled_volume_m3_ = 0.0;    ///< soft body's enclosed volume at construction / after settle()
+  std::vector<double> settled_volume_m3_;  ///< each soft body's enclosed volume at construction / after settle()
   ContactProxy proxy_{};
   HostStatus status_{};
   /// Per rt tool part: the low-passed velocity of the tissue under it (session_host.cpp,

@@ -84,6 +84,9 @@ struct RenderModel {
   std::string scene_name;
   std::vector<std::array<int, 3>> soft_triangles;  ///< indices into the snapshot's nodes (CCW from outside)
   std::vector<Eigen::Vector3f> soft_rest_world_m;  ///< the settled shape: displacement from it is coloured
+  /// Where each soft body's nodes start in soft_rest_world_m, and their total last: each body's
+  /// rigid motion is fitted on its own (two lobes pushed apart each move as a whole).
+  std::vector<int> soft_body_first_node{0};
   /// Displacement from the settled shape (its rigid motion taken out) drawn fully red [m]: 0.12
   /// of the soft body's smallest half-size (≈ 6 mm for the paper's 5 cm sphere: a 3 mm dent reads half-way to red, over
   /// twice as red as the rest of the ball, which the press squashes and pushes by ~1 mm; deeper
@@ -113,6 +116,8 @@ struct RigidMotion {
 /// whole is not deformed, and over a session a free body's drift (centimetres) would otherwise
 /// outgrow the millimetre scale of a dent.
 [[nodiscard]] RigidMotion fit_rigid_motion(const RenderModel& model, const Eigen::Vector3f* nodes_world_m, std::size_t count) noexcept;
+/// The same over the nodes [first, end) alone (one body of several).
+[[nodiscard]] RigidMotion fit_rigid_motion(const RenderModel& model, const Eigen::Vector3f* nodes_world_m, std::size_t first, std::size_t end) noexcept;
 
 /// Where soft node `node`, now at `p_world_m`, sits on the deformation colour map: 0 where the
 /// body's rigid motion carries its settled position (blue) → 1 at deformation_full_scale_m or

@@ -75,6 +75,7 @@ class SceneRenderer {
   std::vector<float> overlay_vertices_;  // x y (pixels) per vertex
   std::vector<Eigen::Vector3f> soft_normals_;
   std::vector<Eigen::Vector3f> soft_positions_;
+  std::vector<RigidMotion> soft_motions_;  // per soft body, this frame
 };
 
 }  // namespace fissure::viewer
