@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -71,6 +72,64 @@ INSTANTIATE_TEST_SUITE_P(Scenes, PaperScene, ::testing::Values("spatula-sphere",
                            for (char& c : name) c = c == '-' ? '_' : c;
                            return name;
                          });
+
+// Two soft bodies ([[soft_body]], spatula-fissure): the blade slides into the cleft touching
+// both lobes, then pushes the right lobe aside; every contact names its body, no node of either
+// lobe crosses the blade, and the left lobe is not dragged along.
+TEST(HostSimulation, TheBladeInTheFissureTouchesBothLobesAndCrossesNoNodeOfEither) {
+  const SceneDescription scene = load_scene(resolve_scene_path("spatula-fissure"));
+  HostSimulation sim(scene);
+  ASSERT_EQ(sim.soft_body_count(), 2);
+  ASSERT_EQ(sim.first_face(2), sim.soft_face_count());
+  ASSERT_EQ(sim.first_node(2), sim.soft_node_count());
+  // Each body's triangles index its own nodes.
+  for (int b = 0; b < 2; ++b) {
+    for (int f = sim.first_face(b); f < sim.first_face(b + 1); ++f) {
+      for (int corner : sim.soft_faces()[static_cast<std::size_t>(f)]) {
+        ASSERT_GE(corner, sim.first_node(b));
+        ASSERT_LT(corner, sim.first_node(b + 1));
+      }
+    }
+  }
+  sim.settle(0.3);
+  const std::vector<Eigen::Vector3d> rest = sim.node_positions_world_m();
+  std::array<int, 2> contact_steps{0, 0};
+  std::array<double, 2> largest_move_m{0.0, 0.0};
+  int crossed_max = 0;
+  bool finite = true;
+  const long steps = std::lround(trajectory_duration_s(scene) / scene.simulation.time_step_s);
+  for (long i = 0; i < steps; ++i) {
+    const TrajectorySample target = sim.scripted_target();
+    const HostStepResult& r = sim.step(to_tool_pose(target.pose), target.jaw_gap_m);
+    crossed_max = std::max(crossed_max, r.crossing.crossed_nodes);
+    finite = finite && r.force_on_tool_world_n.allFinite();
+    std::array<bool, 2> touched{false, false};
+    for (const ContactRecord& c : r.contacts) {
+      ASSERT_TRUE(c.soft_body == 0 || c.soft_body == 1) << c.soft_body;
+      ASSERT_GE(c.soft_face, 0);
+      ASSERT_LT(c.soft_face, sim.first_face(c.soft_body + 1) - sim.first_face(c.soft_body));
+      touched[static_cast<std::size_t>(c.soft_body)] = true;
+    }
+    for (int b = 0; b < 2; ++b) contact_steps[static_cast<std::size_t>(b)] += touched[static_cast<std::size_t>(b)] ? 1 : 0;
+    for (int b = 0; b < 2; ++b) {
+      for (int n = sim.first_node(b); n < sim.first_node(b + 1); ++n) {
+        const auto k = static_cast<std::size_t>(n);
+        largest_move_m[static_cast<std::size_t>(b)] = std::max(largest_move_m[static_cast<std::size_t>(b)], (sim.node_positions_world_m()[k] - rest[k]).norm());
+      }
+    }
+  }
+  EXPECT_EQ(crossed_max, 0);
+  EXPECT_TRUE(finite);
+  EXPECT_GT(contact_steps[0], 20) << "the blade must touch the left lobe on its way down the cleft";
+  EXPECT_GT(contact_steps[1], 500) << "and push the right lobe";
+  EXPECT_GT(largest_move_m[1], 0.004) << "the 6 mm push opens the fissure";
+  EXPECT_LT(largest_move_m[0], 0.001) << "the left lobe stays where it lies";
+}
+
+TEST(HostSimulation, BulletsOwnCollisionIsRefusedForSeveralBodies) {
+  const SceneDescription scene = load_scene(resolve_scene_path("spatula-fissure"));
+  EXPECT_THROW(HostSimulation(scene, SceneCollisionMethod::kBullet), std::invalid_argument);
+}
 
 TEST(HostSimulation, TwoRunsGiveIdenticalForceTraces) {
   const SceneDescription scene = load_scene(resolve_scene_path("spatula-sphere"));

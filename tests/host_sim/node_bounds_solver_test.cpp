@@ -28,43 +28,51 @@ void expect_same_world_and_exact_bounds(const std::string& scene_file, int steps
   const SceneDescription scene = load_scene(scene_file);
   SoftWorld ours(scene, false, true);
   SoftWorld stock(scene, false, false);
-  ASSERT_NE(ours.node_bounds(), nullptr);
-  ASSERT_EQ(stock.node_bounds(), nullptr);
+  ASSERT_EQ(ours.soft_body_count(), static_cast<int>(scene.soft_bodies.size()));
+  for (int body = 0; body < ours.soft_body_count(); ++body) {
+    ASSERT_NE(ours.node_bounds(body), nullptr);
+    ASSERT_EQ(stock.node_bounds(body), nullptr);
+  }
   const double h = scene.simulation.time_step_s / scene.simulation.substeps_count;
   for (int s = 0; s < steps; ++s) {
     ours.step(h);
     stock.step(h);
-    const btSoftBody& a = ours.soft();
-    const btSoftBody& b = stock.soft();
-    const SoftNodeBounds& bounds = *ours.node_bounds();
-    ASSERT_TRUE(bounds.valid) << scene_file << " step " << s;
-    ASSERT_EQ(bounds.node_count, a.m_nodes.size());
-    const btVector3 large(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT);
-    btVector3 all_lo = large, all_hi = -large;
-    for (int blk = 0; blk < bounds.block_count(); ++blk) {
-      btVector3 lo = large, hi = -large;
-      const int first = blk * SoftNodeBounds::kNodesPerBlock;
-      const int last = std::min(a.m_nodes.size(), first + SoftNodeBounds::kNodesPerBlock);
-      for (int i = first; i < last; ++i) {
-        const btSoftBody::Node& n = a.m_nodes[i];
-        ASSERT_TRUE(same_bits(n.m_x, b.m_nodes[i].m_x)) << scene_file << " step " << s << " node " << i << ": m_x";
-        ASSERT_TRUE(same_bits(n.m_q, b.m_nodes[i].m_q)) << scene_file << " step " << s << " node " << i << ": m_q";
-        ASSERT_TRUE(same_bits(n.m_v, b.m_nodes[i].m_v)) << scene_file << " step " << s << " node " << i << ": m_v";
-        lo.setMin(n.m_x), lo.setMin(n.m_q), hi.setMax(n.m_x), hi.setMax(n.m_q);
+    for (int body = 0; body < ours.soft_body_count(); ++body) {
+      const btSoftBody& a = ours.soft(body);
+      const btSoftBody& b = stock.soft(body);
+      const SoftNodeBounds& bounds = *ours.node_bounds(body);
+      const std::string where = scene_file + " body " + std::to_string(body) + " step " + std::to_string(s);
+      ASSERT_TRUE(bounds.valid) << where;
+      ASSERT_EQ(bounds.node_count, a.m_nodes.size());
+      const btVector3 large(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT);
+      btVector3 all_lo = large, all_hi = -large;
+      for (int blk = 0; blk < bounds.block_count(); ++blk) {
+        btVector3 lo = large, hi = -large;
+        const int first = blk * SoftNodeBounds::kNodesPerBlock;
+        const int last = std::min(a.m_nodes.size(), first + SoftNodeBounds::kNodesPerBlock);
+        for (int i = first; i < last; ++i) {
+          const btSoftBody::Node& n = a.m_nodes[i];
+          ASSERT_TRUE(same_bits(n.m_x, b.m_nodes[i].m_x)) << where << " node " << i << ": m_x";
+          ASSERT_TRUE(same_bits(n.m_q, b.m_nodes[i].m_q)) << where << " node " << i << ": m_q";
+          ASSERT_TRUE(same_bits(n.m_v, b.m_nodes[i].m_v)) << where << " node " << i << ": m_v";
+          lo.setMin(n.m_x), lo.setMin(n.m_q), hi.setMax(n.m_x), hi.setMax(n.m_q);
+        }
+        ASSERT_TRUE(same_bits(lo, bounds.block_lo[static_cast<std::size_t>(blk)])) << where << " block " << blk;
+        ASSERT_TRUE(same_bits(hi, bounds.block_hi[static_cast<std::size_t>(blk)])) << where << " block " << blk;
+        all_lo.setMin(lo), all_hi.setMax(hi);
       }
-      ASSERT_TRUE(same_bits(lo, bounds.block_lo[static_cast<std::size_t>(blk)])) << scene_file << " step " << s << " block " << blk;
-      ASSERT_TRUE(same_bits(hi, bounds.block_hi[static_cast<std::size_t>(blk)])) << scene_file << " step " << s << " block " << blk;
-      all_lo.setMin(lo), all_hi.setMax(hi);
+      ASSERT_TRUE(same_bits(all_lo, bounds.all_lo) && same_bits(all_hi, bounds.all_hi)) << where;
     }
-    ASSERT_TRUE(same_bits(all_lo, bounds.all_lo) && same_bits(all_hi, bounds.all_hi)) << scene_file << " step " << s;
   }
 }
 
 // The sphere drops onto the ground and bounces (ground contacts in the position solve); the
-// vessel is anchored to the ground (Bullet anchors, [[soft_body.anchor]]).
+// vessel is anchored to the ground (Bullet anchors, [[soft_body.anchor]]); the fissure's two
+// lobes ([[soft_body]]) settle side by side, each solved and bounded by the same solver.
 TEST(NodeBoundsSolver, IsBulletsOwnSolveBitForBitWithExactBounds) {
   expect_same_world_and_exact_bounds("scenes/spatula-sphere.toml", 400);
   expect_same_world_and_exact_bounds("scenes/clamp-vessel.toml", 200);
+  expect_same_world_and_exact_bounds("scenes/spatula-fissure.toml", 200);
 }
 
 TEST(NodeBoundsSolver, ABodyItCannotReproduceGetsTheStockSolveAndNoBounds) {
@@ -85,8 +93,8 @@ TEST(NodeBoundsSolver, ABodyItCannotReproduceGetsTheStockSolveAndNoBounds) {
 // The whole host step, paired, with the broad phase reading the solver's bounds vs reading every
 // node: the same forces and node positions, bit for bit, through plunges, holds and a squeeze —
 // including the clamp, whose second jaw's broad phase runs after the first jaw moved nodes.
-void expect_same_simulation(const std::string& scene_file, double seconds) {
-  const SceneDescription scene = load_scene(scene_file);
+void expect_same_simulation(const SceneDescription& scene, double seconds) {
+  const std::string& scene_file = scene.name;
   HostSimulation with_bounds(scene, SceneCollisionMethod::kPaired, HostSimulationOptions{true});
   HostSimulation scanning(scene, SceneCollisionMethod::kPaired, HostSimulationOptions{false});
   ASSERT_NE(with_bounds.world().node_bounds(), nullptr);
@@ -108,8 +116,13 @@ void expect_same_simulation(const std::string& scene_file, double seconds) {
 }
 
 TEST(NodeBoundsSolver, PairedSimulationIsTheSameWithTheSolversBounds) {
-  expect_same_simulation("scenes/spatula-sphere.toml", 1.5);
-  expect_same_simulation("scenes/clamp-sphere.toml", 2.0);
+  expect_same_simulation(load_scene("scenes/spatula-sphere.toml"), 1.5);
+  expect_same_simulation(load_scene("scenes/clamp-sphere.toml"), 2.0);
+  // Two bodies, each with its own bounds; the response after the step (the in-solver response
+  // needs the bounding solver, so it has no scanning twin).
+  SceneDescription fissure = load_scene("scenes/spatula-fissure.toml");
+  fissure.simulation.contact_response = ContactResponse::kAfterStep;
+  expect_same_simulation(fissure, 2.0);
 }
 
 // A contact solved with the body (the in-solver response's hook): begin_solve once per step on

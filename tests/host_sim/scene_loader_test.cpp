@@ -244,6 +244,57 @@ TEST(SceneLoader, MalformedAnchorsNameFileLineAndField) {
   expect_error(load_error(not_table), line_of(not_table, "anchor = 1"), "soft_body.anchor", "array of tables");
 }
 
+// [[soft_body]]: several bodies, each read as the single [soft_body] table, anchors inside each.
+TEST(SceneLoader, SeveralSoftBodiesAreReadEachWithItsAnchors) {
+  const SceneDescription fissure = load_scene(kScenes / "spatula-fissure.toml");
+  ASSERT_EQ(fissure.soft_bodies.size(), 2u);
+  for (std::size_t b = 0; b < 2; ++b) {
+    SCOPED_TRACE(b);
+    const SoftBodyDescription& body = fissure.soft_bodies[b];
+    ASSERT_TRUE(std::holds_alternative<SoftMesh>(body.shape));
+    EXPECT_EQ(std::get<SoftMesh>(body.shape).triangles.size(), 1280u);
+    ASSERT_EQ(body.anchors.size(), 1u);
+    EXPECT_DOUBLE_EQ(body.mass_kg, 0.1);
+  }
+  EXPECT_DOUBLE_EQ(std::get<SoftMesh>(fissure.soft_bodies[0].shape).offset_world_m[0], -0.0505);
+  EXPECT_DOUBLE_EQ(std::get<SoftMesh>(fissure.soft_bodies[1].shape).offset_world_m[0], 0.0505);
+  EXPECT_DOUBLE_EQ(fissure.soft_bodies[0].anchors[0].max_world_m[0], 0.0);
+  EXPECT_DOUBLE_EQ(fissure.soft_bodies[1].anchors[0].min_world_m[0], 0.0);
+  // The single-table form is one body.
+  EXPECT_EQ(load_scene(kScenes / "spatula-sphere.toml").soft_bodies.size(), 1u);
+}
+
+TEST(SceneLoader, ABadValueInTheSecondSoftBodyNamesThatBody) {
+  const std::string good = read(kScenes / "spatula-fissure.toml");
+  const std::string right_lobe = "offset_world_m = [0.0505, 0.02075, 0.0]\nmass_kg = 0.1\nlinear_stiffness_ratio = 1.0";
+  const std::string stiff = replace(good, right_lobe, "offset_world_m = [0.0505, 0.02075, 0.0]\nmass_kg = 0.1\nlinear_stiffness_ratio = 2.0");
+  expect_error(load_error(stiff), line_of(stiff, "linear_stiffness_ratio = 2.0"), "soft_body[1].linear_stiffness_ratio", "must be in");
+  const std::string unknown = replace(good, right_lobe, right_lobe + "\nyoungs_modulus = 3000");
+  expect_error(load_error(unknown), line_of(unknown, "youngs_modulus"), "soft_body[1].youngs_modulus", "unknown key");
+  // The right lobe's anchor box moved above both lobes selects none of its nodes.
+  const std::string empty = replace(good, "min_world_m = [0.0, -0.01, -0.04]\nmax_world_m = [0.11, 0.012, 0.04]",
+                                    "min_world_m = [0.0, 0.2, -0.04]\nmax_world_m = [0.11, 0.3, 0.04]");
+  expect_error(load_error(empty), line_of(empty, "min_world_m = [0.0, 0.2") - 1, "soft_body[1].anchor[0]", "selects no soft node");
+}
+
+TEST(SceneLoader, MoreSoftBodiesThanTheLimitAreRefused) {
+  const std::string sphere = read(kScenes / "spatula-sphere.toml");
+  const std::size_t begin = sphere.find("[soft_body]");
+  const std::size_t end = sphere.find("[tool]");
+  ASSERT_NE(begin, std::string::npos);
+  // The sphere's [soft_body] table as one [[soft_body]] entry.
+  const std::size_t header = std::string("[soft_body]").size();
+  const std::string table = "[[soft_body]]" + sphere.substr(begin + header, end - begin - header);
+  std::string bodies;
+  for (int i = 0; i <= kMaxSoftBodies; ++i) bodies += table;
+  const std::string many = sphere.substr(0, begin) + bodies + sphere.substr(end);
+  expect_error(load_error(many), line_of(many, "[[soft_body]]"), "soft_body", "1 to " + std::to_string(kMaxSoftBodies) + " soft bodies (got 9)");
+  std::string eight;
+  for (int i = 0; i < kMaxSoftBodies; ++i) eight += table;
+  EXPECT_EQ(load_scene_text(sphere.substr(0, begin) + eight + sphere.substr(end), "ok.toml", kScenes).soft_bodies.size(),
+            static_cast<std::size_t>(kMaxSoftBodies));
+}
+
 TEST(SceneLoader, DeformationMeasureIsOptionalAndChecked) {
   const std::string good = read(kScenes / "spatula-sphere.toml");
   EXPECT_EQ(load_scene_text(good, "good.toml", kScenes).hunt_crossley.measure, DeformationMeasure::kNormalDisplacement);
