@@ -14,6 +14,7 @@ packages=(
   libfcl-dev  # tests/host_sim only: the independent triangle–convex oracle of the contact metrics (fcl_oracle.hpp)
   libusb-1.0-0-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libspdlog-dev
   libtinyobjloader-dev
+  tetgen  # tests/host_sim: a real TetGen run of a closed STL into a volumetric body (skipped, saying so, without it)
   libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libglfw3-dev libpng-dev  # viewer/: headless EGL (llvmpipe), GL 3.3, GLFW window, PNG
   # session plot (Debian's interpreter, not whatever python3 is first on PATH)
   python3 python3-matplotlib

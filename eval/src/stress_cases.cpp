@@ -150,7 +150,7 @@ void random_hand(StressSetup& s, HandStyle style, std::uint64_t seed) {
 
 /// [[soft_body.anchor]] over the ball's bottom cap (kAnchorCapHeight_m, stress_cases.hpp says why).
 void anchor_bottom_cap(host::SceneDescription& scene) {
-  const std::vector<Vec3> rest = host::soft_body_rest_nodes_world_m(scene.soft_bodies.front());
+  const std::vector<Vec3> rest = host::soft_body_rest(scene.soft_bodies.front()).nodes_world_m;
   double lowest_m = std::numeric_limits<double>::infinity();
   for (const Vec3& v : rest) lowest_m = std::min(lowest_m, v[1]);
   // x and z: the whole ground (half extents), so the cap is selected by height alone.

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <iomanip>
 #include <map>
 #include <optional>
 #include <set>
@@ -100,12 +101,11 @@ void read_ground(TableReader& t, GroundDescription& ground) {
   t.finish();
 }
 
-// [[soft_body.anchor]]: world boxes; each must select at least one node of the rest mesh
-// (an empty box is a typo in a coordinate, not a wish for no anchor).
-void read_anchors(const std::string& file, TableReader& t, SoftBodyDescription& soft) {
-  const toml::array* boxes = t.array_of_tables("anchor");
-  if (boxes == nullptr) return;
+// [[soft_body.anchor]]: world boxes, read into `soft`; returns each box's table line.
+std::vector<int> read_anchors(const std::string& file, TableReader& t, SoftBodyDescription& soft) {
   std::vector<int> lines;
+  const toml::array* boxes = t.array_of_tables("anchor");
+  if (boxes == nullptr) return lines;
   for (std::size_t i = 0; i < boxes->size(); ++i) {
     const toml::table& table = *boxes->get(i)->as_table();
     TableReader a(file, table, child_path(t, "anchor[" + std::to_string(i) + "]"));
@@ -121,16 +121,33 @@ void read_anchors(const std::string& file, TableReader& t, SoftBodyDescription& 
     soft.anchors.push_back(box);
     lines.push_back(a.table_line());
   }
-  const std::vector<Vec3> rest = soft_body_rest_nodes_world_m(soft);
+  return lines;
+}
+
+// What only the built body tells: each anchor box selects at least one node of the rest mesh
+// (an empty box is a typo in a coordinate, not a wish for no anchor), and pose matching has a
+// pose matrix Bullet can decompose (kPoseMatchingMinNormProduct_m4 says why).
+void check_rest_shape(const std::string& file, TableReader& t, const SoftBodyDescription& soft, const std::vector<int>& anchor_lines) {
+  if (soft.anchors.empty() && !(soft.shape_matching_ratio > 0.0)) return;
+  const SoftBodyRest rest = soft_body_rest(soft);
   for (std::size_t i = 0; i < soft.anchors.size(); ++i) {
-    if (!nodes_in_anchor_box(rest, soft.anchors[i]).empty()) continue;
+    if (!nodes_in_anchor_box(rest.nodes_world_m, soft.anchors[i]).empty()) continue;
     Eigen::AlignedBox3d bounds;
-    for (const Vec3& v : rest) bounds.extend(Eigen::Vector3d(v[0], v[1], v[2]));
+    for (const Vec3& v : rest.nodes_world_m) bounds.extend(Eigen::Vector3d(v[0], v[1], v[2]));
     std::ostringstream msg;
-    msg << "the box selects no soft node (the rest mesh's " << rest.size() << " nodes span [" << bounds.min().x() << ", "
+    msg << "the box selects no soft node (the rest mesh's " << rest.nodes_world_m.size() << " nodes span [" << bounds.min().x() << ", "
         << bounds.min().y() << ", " << bounds.min().z() << "] .. [" << bounds.max().x() << ", " << bounds.max().y() << ", "
         << bounds.max().z() << "] m)";
-    throw SceneError(file, lines[i], child_path(t, "anchor[" + std::to_string(i) + "]"), msg.str());
+    throw SceneError(file, anchor_lines[i], child_path(t, "anchor[" + std::to_string(i) + "]"), msg.str());
+  }
+  if (rest.pose_matrix_norm_product_m4 < kPoseMatchingMinNormProduct_m4) {
+    std::ostringstream msg;
+    msg << std::fixed << std::setprecision(1) << "this body is too small for Bullet's pose matching: its rest radius of gyration is "
+        << rest.pose_radius_of_gyration_m * 1e3 << std::defaultfloat << std::setprecision(3)
+        << " mm and its pose matrix's |A|_1*|A|_inf " << rest.pose_matrix_norm_product_m4 << " m^4, below " << kPoseMatchingMinNormProduct_m4
+        << " m^4 (the single-precision bound under which Bullet's polar decomposition fails and the body collapses to its centre; a "
+           "round body needs a radius of gyration of about 32 mm or more): set shape_matching_ratio = 0 or use a larger body";
+    t.fail(t.line_for("shape_matching", "ratio"), "shape_matching_ratio", msg.str());
   }
 }
 
@@ -153,7 +170,7 @@ void read_fem_material(const std::string& file, TableReader& t, SoftBodyDescript
   soft.collision_margin_m = t.in_range("collision_margin", "m", 0.0, 0.1);
   TetMesh tet{"", mesh->vertices_world_m, mesh->tetrahedra, {}, 0};
   soft.mass_kg = m.density_kg_per_m3 * tet_mesh_volume_m3(tet);
-  read_anchors(file, t, soft);
+  check_rest_shape(file, t, soft, read_anchors(file, t, soft));
   t.finish();
 }
 
@@ -235,7 +252,7 @@ void read_soft_body(const std::string& file, TableReader& t, SoftBodyDescription
   soft.friction_ratio = t.in_range("friction", "ratio", 0.0, 1.0);
   soft.position_iterations_count = t.count("position_iterations", 1, 1000);
   soft.collision_margin_m = t.in_range("collision_margin", "m", 0.0, 0.1);
-  read_anchors(file, t, soft);
+  check_rest_shape(file, t, soft, read_anchors(file, t, soft));
   t.finish();
 }
 

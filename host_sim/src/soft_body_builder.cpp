@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <memory>
 #include <stdexcept>
@@ -326,18 +327,31 @@ btSoftBody* build_soft_body(btSoftBodyWorldInfo& world_info, const SoftBodyDescr
   return body;
 }
 
-std::vector<Vec3> soft_body_rest_nodes_world_m(const SoftBodyDescription& description) {
-  // The same construction as the world's body, in a throw-away world info (the meshes never
-  // touch its broadphase or SDF), so the selection is exactly the nodes the world will have.
+SoftBodyRest soft_body_rest(const SoftBodyDescription& description) {
   btSoftBodyWorldInfo info;
   const std::unique_ptr<btSoftBody> body(build_soft_body(info, description));
-  std::vector<Vec3> nodes;
-  nodes.reserve(static_cast<std::size_t>(body->m_nodes.size()));
+  SoftBodyRest rest;
+  rest.nodes_world_m.reserve(static_cast<std::size_t>(body->m_nodes.size()));
   for (int i = 0; i < body->m_nodes.size(); ++i) {
     const btVector3& x = body->m_nodes[i].m_x;
-    nodes.push_back({x.x(), x.y(), x.z()});
+    rest.nodes_world_m.push_back({x.x(), x.y(), x.z()});
   }
-  return nodes;
+  rest.pose_matrix_norm_product_m4 = std::numeric_limits<double>::infinity();
+  if (body->m_pose.m_bframe) {
+    // setPose's weights and rest offsets, summed in double: the figure is the body's, not the
+    // rounding of this sum.
+    const btSoftBody::Pose& pose = body->m_pose;
+    Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+    for (int i = 0; i < pose.m_pos.size(); ++i) {
+      const Eigen::Vector3d q(pose.m_pos[i].x(), pose.m_pos[i].y(), pose.m_pos[i].z());
+      a += static_cast<double>(pose.m_wgh[i]) * q * q.transpose();
+    }
+    const double norm_1 = a.cwiseAbs().colwise().sum().maxCoeff();
+    const double norm_inf = a.cwiseAbs().rowwise().sum().maxCoeff();
+    rest.pose_matrix_norm_product_m4 = norm_1 * norm_inf;
+    rest.pose_radius_of_gyration_m = std::sqrt(a.trace());
+  }
+  return rest;
 }
 
 std::vector<int> nodes_in_anchor_box(const std::vector<Vec3>& nodes_world_m, const SoftAnchorBox& box) {

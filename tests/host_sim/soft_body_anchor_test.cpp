@@ -82,7 +82,7 @@ PushResult push_sideways(HostSimulation& sim, double push_m) {
 
 TEST(SoftBodyAnchor, SelectsTheRestNodesInsideTheBox) {
   SceneDescription scene = sphere_scene();
-  const std::vector<Vec3> rest = soft_body_rest_nodes_world_m(scene.soft_bodies.front());
+  const std::vector<Vec3> rest = soft_body_rest(scene.soft_bodies.front()).nodes_world_m;
   ASSERT_EQ(rest.size(), 66u);  // CreateEllipsoid(res 63): 66 nodes, 128 faces
   const std::vector<int> cap = nodes_in_anchor_box(rest, bottom_cap());
   ASSERT_FALSE(cap.empty());
@@ -150,7 +150,7 @@ TEST(SoftBodyAnchor, AnchoredNodesDisplacedByTheToolReturn) {
   // The ball's left side (x ≤ −4 cm), where the plate presses in.
   const SoftAnchorBox side{{-0.1, 0.03, -0.03}, {-0.04, 0.075, 0.03}};
   scene.soft_bodies.front().anchors.push_back(side);
-  const std::vector<int> side_nodes = nodes_in_anchor_box(soft_body_rest_nodes_world_m(scene.soft_bodies.front()), side);
+  const std::vector<int> side_nodes = nodes_in_anchor_box(soft_body_rest(scene.soft_bodies.front()).nodes_world_m, side);
   ASSERT_GE(side_nodes.size(), 2u);
   HostSimulation sim(scene);
   const PushResult push = push_sideways(sim, 0.02);  // 1 cm past first touch

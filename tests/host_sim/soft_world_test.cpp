@@ -140,8 +140,8 @@ bool inside_surface(const btSoftBody& soft, const btVector3& p) {
 }
 
 // The paper's 50 mm ball twice, one above the other: the lower tied to the ground by its lower
-// half, the upper dropped from 4 mm above it. (Smaller balls with pose matching collapse in
-// Bullet alone: docs/decisions.md, issue 24.) drop(false) takes the soft–soft collision away.
+// half, the upper dropped from 4 mm above it. (Balls under ~32 mm radius with pose matching
+// collapse in Bullet alone: PoseMatchingKeeps… below.) drop(false) takes the soft–soft collision away.
 SceneDescription stacked_balls() {
   SceneDescription scene = load_scene("scenes/spatula-sphere.toml");
   SoftBodyDescription lower = scene.soft_bodies.front();
@@ -217,6 +217,48 @@ TEST(SoftWorld, RefusesTooManyBodiesAndBulletsOwnCollisionWithSeveral) {
   EXPECT_THROW(SoftWorld(scene, true), std::invalid_argument);  // the bullet method: one body
   scene.soft_bodies.assign(static_cast<std::size_t>(kMaxSoftBodies) + 1, scene.soft_bodies.front());
   EXPECT_THROW(SoftWorld(scene, false), std::invalid_argument);
+}
+
+// The paper's ball scaled to `radius_m`, pose matching on (kMT 0.05), 1 m above the ground.
+SceneDescription falling_ball(double radius_m) {
+  SceneDescription scene = load_scene("scenes/spatula-sphere.toml");
+  SoftSphere sphere = std::get<SoftSphere>(scene.soft_bodies.front().shape);
+  sphere.radius_m = radius_m;
+  sphere.center_world_m = {0.0, 1.0, 0.0};
+  scene.soft_bodies.front().shape = sphere;
+  scene.soft_bodies.front().anchors.clear();
+  return scene;
+}
+
+// Its width along x after `fall_s` of 1 ms steps from its centre at `height_m`.
+double width_after_free_fall_m(double radius_m, double fall_s, double height_m = 1.0) {
+  SceneDescription scene = falling_ball(radius_m);
+  std::get<SoftSphere>(scene.soft_bodies.front().shape).center_world_m[1] = height_m;
+  SoftWorld world(scene, false);
+  for (int s = 0; s < static_cast<int>(std::lround(fall_s / 0.001)); ++s) world.step(0.001);
+  double lo = 1e9, hi = -1e9;
+  for (int i = 0; i < world.soft().m_nodes.size(); ++i) {
+    lo = std::min(lo, double(world.soft().m_nodes[i].m_x.x()));
+    hi = std::max(hi, double(world.soft().m_nodes[i].m_x.x()));
+  }
+  return hi - lo;
+}
+
+// Why the loader refuses pose matching under kPoseMatchingMinNormProduct_m4: the paper's ball
+// just under Bullet's bound (30 mm radius) shrinks to under half its width in 0.1 s of free
+// fall; just over it (32 mm) it keeps its width falling, resting on the ground and dropped.
+TEST(SoftWorld, PoseMatchingKeepsABallAboveBulletsBoundAndCollapsesOneBelowIt) {
+  const double below_m = 0.030, above_m = 0.032;
+  ASSERT_LT(soft_body_rest(falling_ball(below_m).soft_bodies.front()).pose_matrix_norm_product_m4, kPoseMatchingMinNormProduct_m4);
+  ASSERT_GE(soft_body_rest(falling_ball(above_m).soft_bodies.front()).pose_matrix_norm_product_m4, kPoseMatchingMinNormProduct_m4);
+  EXPECT_LT(width_after_free_fall_m(below_m, 0.1) / (2.0 * below_m), 0.6);
+  EXPECT_GT(width_after_free_fall_m(above_m, 0.1) / (2.0 * above_m), 0.99);
+  EXPECT_GT(width_after_free_fall_m(above_m, 1.0, above_m + 0.002) / (2.0 * above_m), 0.99) << "resting on the ground";
+  EXPECT_GT(width_after_free_fall_m(above_m, 1.0, above_m + 0.05) / (2.0 * above_m), 0.99) << "dropped 5 cm";
+  // Without pose matching the body has no pose matrix to refuse.
+  SceneDescription plain = falling_ball(below_m);
+  plain.soft_bodies.front().shape_matching_ratio = 0.0;
+  EXPECT_TRUE(std::isinf(soft_body_rest(plain.soft_bodies.front()).pose_matrix_norm_product_m4));
 }
 
 }  // namespace

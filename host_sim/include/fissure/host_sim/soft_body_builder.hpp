@@ -88,9 +88,30 @@ struct VolumeMesh {
 /// The caller owns the result (a btSoftRigidDynamicsWorld does not delete its bodies).
 [[nodiscard]] btSoftBody* build_soft_body(btSoftBodyWorldInfo& world_info, const SoftBodyDescription& description);
 
-/// The soft body's node positions as built (its rest shape, before any settling), world
-/// frame: what [[soft_body.anchor]] boxes select from (the loader checks each box selects one).
-[[nodiscard]] std::vector<Vec3> soft_body_rest_nodes_world_m(const SoftBodyDescription& description);
+/// Bullet's pose matching (kMT, shape_matching_ratio) needs the polar decomposition of the
+/// pose matrix A = Σ wᵢ (xᵢ − c) qᵢᵀ (weights wᵢ summing to 1, so A is in m²). btPolarDecomposition
+/// (LinearMath, Bullet 3.24) treats A as singular when ‖A‖₁·‖A‖∞ < SIMD_EPSILON and then returns
+/// A itself as the "rotation": the goal shape shrinks with the body and the body collapses to
+/// its centre. In Debian's single-precision build SIMD_EPSILON is FLT_EPSILON, so the bound is
+/// 1.19e-7 m⁴ — a round shell of ~32 mm radius. The loader refuses a body under it; above it a
+/// body keeps its shape falling, resting and dropped (SoftWorld.PoseMatching… tests).
+inline constexpr double kPoseMatchingMinNormProduct_m4 = static_cast<double>(SIMD_EPSILON);
+
+/// A soft body as built, before any settling: what the loader checks a description against.
+struct SoftBodyRest {
+  /// Node positions, world frame: what [[soft_body.anchor]] boxes select from (the loader
+  /// checks each box selects one).
+  std::vector<Vec3> nodes_world_m;
+  /// ‖A‖₁·‖A‖∞ of the rest pose matrix A = Σ wᵢ qᵢ qᵢᵀ [m⁴] (see
+  /// kPoseMatchingMinNormProduct_m4); +inf when the body has no pose matching.
+  double pose_matrix_norm_product_m4 = 0.0;
+  /// √trace(A), the rest shape's mass-weighted radius of gyration about its centre [m] (a
+  /// closed spherical shell's radius); 0 when the body has no pose matching.
+  double pose_radius_of_gyration_m = 0.0;
+};
+/// Builds the body as the world does, in a throw-away world info (the meshes never touch its
+/// broadphase or SDF), so the figures are exactly those of the world's body.
+[[nodiscard]] SoftBodyRest soft_body_rest(const SoftBodyDescription& description);
 
 /// Indices of the nodes (of `nodes_world_m`) inside `box`, bounds included, ascending.
 [[nodiscard]] std::vector<int> nodes_in_anchor_box(const std::vector<Vec3>& nodes_world_m, const SoftAnchorBox& box);
