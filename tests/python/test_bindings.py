@@ -269,3 +269,31 @@ def test_mesh_bench_rows_name_their_sizes():
     rows = result["tool_meshes"]
     assert rows and all(row["triangles"] > 0 and row["load_s"] > 0.0 for row in rows)
     assert all(row["tetrahedra"] > 0 for row in result["tet_meshes"])
+
+
+def test_several_soft_bodies_are_laid_out_body_after_body_and_contacts_name_their_body():
+    sim = fissure.HostSimulation(fissure.Scene.load("spatula-fissure"))
+    assert sim.soft_body_count == 2
+    slices = [sim.soft_body_nodes(b) for b in range(2)]
+    assert slices[0].start == 0 and slices[0].stop == slices[1].start and slices[1].stop == sim.soft_node_count
+    with pytest.raises(IndexError):
+        sim.soft_body_nodes(2)
+    nodes = sim.node_positions()
+    # The two lobes lie either side of the cleft at x = 0.
+    assert nodes[slices[0], 0].max() < 0.0 < nodes[slices[1], 0].min()
+    faces = sim.faces()
+    assert faces.shape == (sim.soft_face_count, 3)
+    sim.settle(0.3)
+    seen = set()
+    for _ in range(2000):
+        r = sim.step(sim.scripted_target()[0])
+        c = r.contacts
+        assert c["soft_body"].shape == (r.contact_count,) and c["soft_body"].dtype == np.int32
+        for body, face in zip(c["soft_body"], c["soft_face"]):
+            # soft_face is global: its nodes are rows of the contact's own body.
+            corners = faces[face]
+            assert slices[body].start <= corners.min() and corners.max() < slices[body].stop
+            seen.add(int(body))
+        if seen == {0, 1}:
+            break
+    assert seen == {0, 1}, "the blade in the cleft touches both lobes"
