@@ -18,15 +18,23 @@ void continue_after_break(BlendState& state, const Eigen::Vector3d& force_in_use
   state.offset_held = true;
 }
 
+namespace {
+// The walk leaves this much of the budget unused [N]: the rendered step is formed from forces of
+// up to the safety clamp (8 N), whose rounding (~1e-15 N) would otherwise put a step that meets
+// the bound exactly a few ulps over it — a step the "≤ max_step_n" contract does not allow.
+constexpr double kBlendRoundingMargin_n = 1e-13;
+}  // namespace
+
 double blend_walk_n(const Eigen::Vector3d& motion_step_n, const Eigen::Vector3d& offset_unit, double offset_norm_n,
                     double max_step_n) noexcept {
-  // |m − s·u|² = |m|² − 2s(m·u) + s² ≤ L², L = max(max_step, |m|) ≥ |m|: s = 0 always fits, and
+  // |m − s·u|² = |m|² − 2s(m·u) + s² ≤ L², L = max(budget, |m|) ≥ |m|: s = 0 always fits, and
   // the feasible s form the interval between the two roots s = m·u ± √((m·u)² + L² − |m|²).
+  const double budget_n = std::max(0.0, max_step_n - kBlendRoundingMargin_n);
   const double m_norm = motion_step_n.norm();
-  const double limit = std::max(max_step_n, m_norm);
+  const double limit = std::max(budget_n, m_norm);
   const double along = motion_step_n.dot(offset_unit);
   const double upper = along + std::sqrt(std::max(0.0, along * along + (limit - m_norm) * (limit + m_norm)));
-  return std::clamp(upper, 0.0, std::min(offset_norm_n, max_step_n));
+  return std::clamp(upper, 0.0, std::min(offset_norm_n, budget_n));
 }
 
 Eigen::Vector3d blend(BlendState& state, const Eigen::Vector3d& new_force_device_n, double max_step_n) noexcept {
