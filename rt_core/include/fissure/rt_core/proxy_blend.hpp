@@ -56,8 +56,9 @@ inline void cancel_swaps(BlendState& state) noexcept {
 void continue_after_break(BlendState& state, const Eigen::Vector3d& force_in_use_device_n) noexcept;
 
 /// The length of this tick's walk of an offset along unit direction −offset_unit, given the
-/// motion step m: the largest s ∈ [0, min(|offset|, max_step_n)] with
-/// |m − s·offset_unit| ≤ max(max_step_n, |m|). Exposed for its test.
+/// motion step m: the largest s ∈ [0, min(|offset|, B)] with |m − s·offset_unit| ≤ max(B, |m|),
+/// B = max_step_n less a 1e-13 N margin that keeps the rendered step within max_step_n after
+/// rounding (proxy_blend.cpp). Exposed for its test.
 double blend_walk_n(const Eigen::Vector3d& motion_step_n, const Eigen::Vector3d& offset_unit, double offset_norm_n,
                     double max_step_n) noexcept;
 
