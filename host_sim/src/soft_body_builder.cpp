@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <limits>
 #include <map>
 #include <memory>
 #include <stdexcept>
@@ -336,7 +335,6 @@ SoftBodyRest soft_body_rest(const SoftBodyDescription& description) {
     const btVector3& x = body->m_nodes[i].m_x;
     rest.nodes_world_m.push_back({x.x(), x.y(), x.z()});
   }
-  rest.pose_matrix_norm_product_m4 = std::numeric_limits<double>::infinity();
   if (body->m_pose.m_bframe) {
     // setPose's weights and rest offsets, summed in double: the figure is the body's, not the
     // rounding of this sum.

@@ -111,11 +111,11 @@ TEST(HostSimulation, TheBladeInTheFissureTouchesBothLobesAndCrossesNoNodeOfEithe
       touched[static_cast<std::size_t>(c.soft_body)] = true;
     }
     for (int b = 0; b < 2; ++b) contact_steps[static_cast<std::size_t>(b)] += touched[static_cast<std::size_t>(b)] ? 1 : 0;
+    const std::vector<Eigen::Vector3d>& nodes = sim.node_positions_world_m();
     for (int b = 0; b < 2; ++b) {
-      for (int n = sim.first_node(b); n < sim.first_node(b + 1); ++n) {
-        const auto k = static_cast<std::size_t>(n);
-        largest_move_m[static_cast<std::size_t>(b)] = std::max(largest_move_m[static_cast<std::size_t>(b)], (sim.node_positions_world_m()[k] - rest[k]).norm());
-      }
+      double& largest = largest_move_m[static_cast<std::size_t>(b)];
+      for (auto k = static_cast<std::size_t>(sim.first_node(b)); k < static_cast<std::size_t>(sim.first_node(b + 1)); ++k)
+        largest = std::max(largest, (nodes[k] - rest[k]).norm());
     }
   }
   EXPECT_EQ(crossed_max, 0);

@@ -219,12 +219,12 @@ TEST(SoftWorld, RefusesTooManyBodiesAndBulletsOwnCollisionWithSeveral) {
   EXPECT_THROW(SoftWorld(scene, false), std::invalid_argument);
 }
 
-// The paper's ball scaled to `radius_m`, pose matching on (kMT 0.05), 1 m above the ground.
-SceneDescription falling_ball(double radius_m) {
+// The paper's ball scaled to `radius_m`, pose matching on (kMT 0.05), its centre at `height_m`.
+SceneDescription falling_ball(double radius_m, double height_m = 1.0) {
   SceneDescription scene = load_scene("scenes/spatula-sphere.toml");
   SoftSphere sphere = std::get<SoftSphere>(scene.soft_bodies.front().shape);
   sphere.radius_m = radius_m;
-  sphere.center_world_m = {0.0, 1.0, 0.0};
+  sphere.center_world_m = {0.0, height_m, 0.0};
   scene.soft_bodies.front().shape = sphere;
   scene.soft_bodies.front().anchors.clear();
   return scene;
@@ -232,9 +232,7 @@ SceneDescription falling_ball(double radius_m) {
 
 // Its width along x after `fall_s` of 1 ms steps from its centre at `height_m`.
 double width_after_free_fall_m(double radius_m, double fall_s, double height_m = 1.0) {
-  SceneDescription scene = falling_ball(radius_m);
-  std::get<SoftSphere>(scene.soft_bodies.front().shape).center_world_m[1] = height_m;
-  SoftWorld world(scene, false);
+  SoftWorld world(falling_ball(radius_m, height_m), false);
   for (int s = 0; s < static_cast<int>(std::lround(fall_s / 0.001)); ++s) world.step(0.001);
   double lo = 1e9, hi = -1e9;
   for (int i = 0; i < world.soft().m_nodes.size(); ++i) {

@@ -6,6 +6,7 @@
 // boundary triangles as faces).
 #include <array>
 #include <cstddef>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -104,7 +105,7 @@ struct SoftBodyRest {
   std::vector<Vec3> nodes_world_m;
   /// ‖A‖₁·‖A‖∞ of the rest pose matrix A = Σ wᵢ qᵢ qᵢᵀ [m⁴] (see
   /// kPoseMatchingMinNormProduct_m4); +inf when the body has no pose matching.
-  double pose_matrix_norm_product_m4 = 0.0;
+  double pose_matrix_norm_product_m4 = std::numeric_limits<double>::infinity();
   /// √trace(A), the rest shape's mass-weighted radius of gyration about its centre [m] (a
   /// closed spherical shell's radius); 0 when the body has no pose matching.
   double pose_radius_of_gyration_m = 0.0;
