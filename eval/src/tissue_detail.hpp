@@ -25,22 +25,9 @@ inline std::vector<int> nodes_where(const host::VolumeMesh& mesh, const std::fun
   return out;
 }
 
-/// Shortest tetrahedron edge [m].
-inline double shortest_edge_m(const host::VolumeMesh& mesh) {
-  double h = std::numeric_limits<double>::infinity();
-  for (const auto& t : mesh.tetrahedra) {
-    for (int a = 0; a < 4; ++a) {
-      for (int b = a + 1; b < 4; ++b) h = std::min(h, (e3(mesh.vertices_m[static_cast<std::size_t>(t[a])]) - e3(mesh.vertices_m[static_cast<std::size_t>(t[b])])).norm());
-    }
-  }
-  return h;
-}
-
-/// The symplectic step's stable size: a fraction (Courant number) of the P-wave's transit of the
-/// shortest edge. 0.3 leaves room for the diagonal edges of a Kuhn cell, which are not the
-/// shortest but whose elements are the stiffest.
-inline double stable_step_s(const host::VolumeMesh& mesh, const host::FemMaterial& material, double courant = 0.3) {
-  return courant * shortest_edge_m(mesh) / host::p_wave_speed_m_per_s(material);
+/// The symplectic step's stable size (host::fem_stable_step_s).
+inline double stable_step_s(const host::VolumeMesh& mesh, const host::FemMaterial& material, double courant = host::kFemCourantRatio) {
+  return host::fem_stable_step_s(mesh, material, courant);
 }
 
 inline Eigen::Vector3d sum_over(const std::vector<Eigen::Vector3d>& f, const std::vector<int>& nodes) {

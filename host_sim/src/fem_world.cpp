@@ -3,7 +3,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
+
+#include <Eigen/Geometry>
 
 // Bullet's deformable headers define inline code (btReducedVector, btAlignedObjectArray::resize
 // of default-constructed btVector3) that GCC 12 flags as maybe-uninitialised once inlined here.
@@ -47,6 +50,25 @@ constexpr btScalar kNewtonTolerance = 1e-9f;
 btVector3 bt(const Eigen::Vector3d& v) { return {static_cast<btScalar>(v.x()), static_cast<btScalar>(v.y()), static_cast<btScalar>(v.z())}; }
 
 }  // namespace
+
+double thinnest_tetrahedron_m(const VolumeMesh& mesh) noexcept {
+  double thinnest = std::numeric_limits<double>::infinity();
+  const auto corner = [&mesh](int v) {
+    const Vec3& p = mesh.vertices_m[static_cast<std::size_t>(v)];
+    return Eigen::Vector3d(p[0], p[1], p[2]);
+  };
+  for (const auto& t : mesh.tetrahedra) {
+    const Eigen::Vector3d a = corner(t[0]), b = corner(t[1]), c = corner(t[2]), d = corner(t[3]);
+    const double six_volume = std::abs((b - a).cross(c - a).dot(d - a));
+    const double twice_largest_face = std::max({(c - b).cross(d - b).norm(), (c - a).cross(d - a).norm(), (b - a).cross(d - a).norm(), (b - a).cross(c - a).norm()});
+    if (twice_largest_face > 0.0) thinnest = std::min(thinnest, six_volume / twice_largest_face);  // 3V / A_max
+  }
+  return thinnest;
+}
+
+double fem_stable_step_s(const VolumeMesh& mesh, const FemMaterial& material, double courant) noexcept {
+  return courant * thinnest_tetrahedron_m(mesh) / p_wave_speed_m_per_s(material);
+}
 
 FemWorld::FemWorld(const FemWorldConfig& config) : config_(config) {
   configuration_ = std::make_unique<btSoftBodyRigidBodyCollisionConfiguration>();

@@ -2,6 +2,8 @@
 #include "fissure/host_sim/soft_world.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -15,6 +17,7 @@
 #include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
 #include <btBulletDynamicsCommon.h>
 
+#include "fissure/host_sim/fem_world.hpp"
 #include "fissure/host_sim/soft_body_builder.hpp"
 
 namespace fissure::host {
@@ -37,6 +40,12 @@ constexpr double kToolShapeMarginRatio = 0.9;
 // corner) small. Measured: with the 1 mm tool voxel a 5120-face ball pressed on the ground
 // spent ~2 ms per step building ground cells.
 constexpr double kGroundOnlyVoxelM = 0.01;
+
+// FEM: the CG cap when stiffness damping couples the nodes (Bullet's own default), and the most
+// symplectic substeps a host step may take — past that a 1 ms host step costs more than a
+// session can wait for (measured: ~1 ms per substep at 1,000 nodes, docs/decisions.md).
+constexpr int kFemDampedCgIterations = 300;
+constexpr int kFemMaxSubsteps = 64;
 
 btVector3 bt(const Vec3& v) { return {static_cast<btScalar>(v[0]), static_cast<btScalar>(v[1]), static_cast<btScalar>(v[2])}; }
 btVector3 bt(const Eigen::Vector3d& v) { return {static_cast<btScalar>(v.x()), static_cast<btScalar>(v.y()), static_cast<btScalar>(v.z())}; }
@@ -104,17 +113,119 @@ void tool_part_poses(const SceneDescription& scene, const ToolPose& tool, double
   }
 }
 
-SoftWorld::SoftWorld(const SceneDescription& scene, bool tool_collides_in_bullet, bool instrumented_solver)
-    : geometry_(tool_part_geometry(scene)), parts_in_world_(tool_collides_in_bullet) {
-  // The FEM body lives in Bullet's deformable world (fem_world.hpp), whose solver is not the
-  // node-bounds solver the thin-body collision reads: refused rather than simulated as a shell.
+void SoftWorld::make_tool_parts(const SceneDescription& scene) {
+  // Kinematic bodies (the tool is driven, never pushed).
+  for (int p = 0; p < geometry_.part_count; ++p) {
+    const double margin_m = kToolShapeMarginRatio * 0.5 * geometry_.thickness_m;
+    if (geometry_.is_mesh) {
+      // btConvexHullShape adds its margin OUTSIDE the hull: give it the mesh's core, the
+      // mesh shrunk by the margin (y flattened, x and z pulled in), so core + margin ≈ mesh.
+      Eigen::AlignedBox3d bounds;
+      for (const Vec3& v : scene.tool.mesh_vertices_tool_m) bounds.extend(Eigen::Vector3d(v[0], v[1], v[2]));
+      const Eigen::Vector3d half = 0.5 * bounds.sizes(), centre = bounds.center();
+      const Eigen::Vector3d scale(1.0 - margin_m / half.x(), 1.0 - margin_m / half.y(), 1.0 - margin_m / half.z());
+      auto hull = std::make_unique<btConvexHullShape>();
+      for (const Vec3& v : scene.tool.mesh_vertices_tool_m) {
+        hull->addPoint(bt(Eigen::Vector3d(centre + scale.cwiseProduct(Eigen::Vector3d(v[0], v[1], v[2]) - centre))), false);
+      }
+      hull->recalcLocalAabb();
+      hull->setMargin(static_cast<btScalar>(margin_m));
+      shapes_.push_back(std::move(hull));
+    } else {
+      auto box = std::make_unique<btBoxShape>(bt(geometry_.box_half_extents_m));
+      box->setMargin(static_cast<btScalar>(margin_m));  // keeps the outer size
+      shapes_.push_back(std::move(box));
+    }
+    motion_states_.push_back(std::make_unique<btDefaultMotionState>(btTransform::getIdentity()));
+    auto body = std::make_unique<btRigidBody>(btRigidBody::btRigidBodyConstructionInfo(0, motion_states_.back().get(), shapes_.back().get()));
+    body->setCollisionFlags(body->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
+    body->setActivationState(DISABLE_DEACTIVATION);
+    body->setFriction(0);
+    parts_[static_cast<std::size_t>(p)] = std::move(body);
+  }
+  std::array<ToolPose, kMaxToolParts> start{};
+  tool_part_poses(scene, to_tool_pose(scene.trajectory.start), scene.trajectory.start_jaw_gap_m >= 0.0 ? scene.trajectory.start_jaw_gap_m : scene.tool.clamp.jaw_gap_open_m, start);
+  for (int p = 0; p < geometry_.part_count; ++p) {
+    btRigidBody& body = *parts_[static_cast<std::size_t>(p)];
+    body.setWorldTransform(bt(start[static_cast<std::size_t>(p)]));
+    body.getMotionState()->setWorldTransform(bt(start[static_cast<std::size_t>(p)]));
+    body.setInterpolationWorldTransform(bt(start[static_cast<std::size_t>(p)]));
+  }
+
+}
+
+// FEM bodies step in Bullet's deformable world (fem_world.hpp): its own solver, not the classic
+// one the node-bounds solver replaces, so the thin-body contact acts after each step (after_step)
+// and the broad phase reads every node. Every body of the scene is FEM (Bullet's deformable and
+// classic soft bodies live in different worlds) and shares the first body's material (Bullet
+// keeps one force per type: FemWorld::add_body). Anchored nodes are fixed (Dirichlet: mass 0),
+// the bed being rigid. The host step is cut into symplectic substeps no longer than the stable
+// step of the stiffest body (fem_stable_step_s): a 1 ms step is unstable on any mesh finer than
+// ~c_p × 1 ms (docs/decisions.md, "Tissue (issue 24)").
+void SoftWorld::build_fem_world(const SceneDescription& scene) {
   for (const SoftBodyDescription& body : scene.soft_bodies) {
-    if (body.model == SoftBodyModel::kFem) {
-      throw std::invalid_argument("[soft_body] model = \"fem\": the host simulation does not step FEM bodies yet (issue 24); `fissure bench tissue` runs them");
+    if (body.model != SoftBodyModel::kFem) {
+      throw std::invalid_argument("[[soft_body]]: an FEM body (model = \"fem\") and a shell cannot share a scene (Bullet steps them in different worlds); make every body \"fem\" or every body a shell");
     }
   }
+  if (parts_in_world_) {
+    throw std::invalid_argument("the bullet collision method runs shell bodies only; an FEM body (model = \"fem\") meets the tool through the paired or ray method");
+  }
+  if (scene.simulation.contact_response == ContactResponse::kInSolver) {
+    throw std::invalid_argument("[simulation] contact_response = \"in_solver\" solves the contact inside the classic soft body's position iterations; an FEM body (model = \"fem\") takes contact_response = \"after_step\"");
+  }
+  FemWorldConfig config;
+  config.gravity_world_m_per_s2 = as_eigen(scene.simulation.gravity_world_m_per_s2);
+  config.has_ground = true;
+  config.ground_top_y_m = scene.ground.top_height_m;
+  config.ground_friction_ratio = scene.ground.friction_ratio;
+  // With mass damping alone the symplectic step's linear system is diagonal and one CG iteration
+  // solves it exactly; stiffness damping couples the nodes and needs the solve (Bullet's cap).
+  const bool stiffness_damped = std::any_of(scene.soft_bodies.begin(), scene.soft_bodies.end(),
+                                            [](const SoftBodyDescription& body) { return body.fem.stiffness_damping_s > 0.0; });
+  config.cg_max_iterations = stiffness_damped ? kFemDampedCgIterations : 1;
+  fem_ = std::make_unique<FemWorld>(config);
+  const double host_step_s = scene.simulation.time_step_s / std::max(1, scene.simulation.substeps_count);
+  double stable_step_s = std::numeric_limits<double>::infinity();
+  first_nodes_.push_back(0);
+  for (const SoftBodyDescription& description : scene.soft_bodies) {
+    const SoftMesh& file = std::get<SoftMesh>(description.shape);  // the loader's check: a tetrahedral mesh
+    const VolumeMesh mesh{file.vertices_world_m, file.tetrahedra, file.triangles};
+    const int b = fem_->add_body(mesh, description.fem, FemContact{description.collision_margin_m, description.friction_ratio});
+    stable_step_s = std::min(stable_step_s, fem_stable_step_s(mesh, description.fem));
+    std::vector<int> fixed;
+    for (std::size_t a = 0; a < description.anchors.size(); ++a) {
+      const std::vector<int> selected = nodes_in_anchor_box(file.vertices_world_m, description.anchors[a]);
+      if (selected.empty()) throw std::invalid_argument("soft_body.anchor[" + std::to_string(a) + "] selects no soft node");
+      fixed.insert(fixed.end(), selected.begin(), selected.end());
+    }
+    std::sort(fixed.begin(), fixed.end());
+    fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
+    fem_->fix_nodes(b, fixed);
+    anchored_nodes_count_ += static_cast<int>(fixed.size());
+    bodies_.push_back(&fem_->body(b));
+    first_nodes_.push_back(first_nodes_.back() + fem_->body(b).m_nodes.size());
+  }
+  sdf_voxel_m_ = config.sdf_voxel_m;
+  fem_substeps_ = std::max(1, static_cast<int>(std::ceil(host_step_s / stable_step_s)));
+  if (fem_substeps_ > kFemMaxSubsteps) {
+    throw std::invalid_argument("[soft_body] model = \"fem\": a " + std::to_string(host_step_s * 1e3) + " ms step needs " + std::to_string(fem_substeps_) +
+                                " substeps for this mesh and material (the stable step is " + std::to_string(stable_step_s * 1e6) +
+                                " us: 0.3 x the shortest edge / the P-wave speed); at most " + std::to_string(kFemMaxSubsteps) +
+                                " are run — use a coarser mesh, a softer material or a shorter time_step_s");
+  }
+  make_tool_parts(scene);
+}
+
+SoftWorld::SoftWorld(const SceneDescription& scene, bool tool_collides_in_bullet, bool instrumented_solver)
+    : geometry_(tool_part_geometry(scene)), parts_in_world_(tool_collides_in_bullet) {
   if (scene.soft_bodies.empty() || static_cast<int>(scene.soft_bodies.size()) > kMaxSoftBodies) {
     throw std::invalid_argument("a scene holds 1 to " + std::to_string(kMaxSoftBodies) + " soft bodies (got " + std::to_string(scene.soft_bodies.size()) + ")");
+  }
+  const auto is_fem = [](const SoftBodyDescription& body) { return body.model == SoftBodyModel::kFem; };
+  if (std::any_of(scene.soft_bodies.begin(), scene.soft_bodies.end(), is_fem)) {
+    build_fem_world(scene);
+    return;
   }
   // Bullet's own tool contact (the baseline) is measured by a probe that watches one body.
   if (tool_collides_in_bullet && scene.soft_bodies.size() > 1) {
@@ -159,43 +270,9 @@ SoftWorld::SoftWorld(const SceneDescription& scene, bool tool_collides_in_bullet
   ground_->setFriction(static_cast<btScalar>(g.friction_ratio));
   world_->addRigidBody(ground_.get());
 
-  // Tool parts: kinematic bodies (the tool is driven, never pushed).
-  for (int p = 0; p < geometry_.part_count; ++p) {
-    const double margin_m = kToolShapeMarginRatio * 0.5 * geometry_.thickness_m;
-    if (geometry_.is_mesh) {
-      // btConvexHullShape adds its margin OUTSIDE the hull: give it the mesh's core, the
-      // mesh shrunk by the margin (y flattened, x and z pulled in), so core + margin ≈ mesh.
-      Eigen::AlignedBox3d bounds;
-      for (const Vec3& v : scene.tool.mesh_vertices_tool_m) bounds.extend(Eigen::Vector3d(v[0], v[1], v[2]));
-      const Eigen::Vector3d half = 0.5 * bounds.sizes(), centre = bounds.center();
-      const Eigen::Vector3d scale(1.0 - margin_m / half.x(), 1.0 - margin_m / half.y(), 1.0 - margin_m / half.z());
-      auto hull = std::make_unique<btConvexHullShape>();
-      for (const Vec3& v : scene.tool.mesh_vertices_tool_m) {
-        hull->addPoint(bt(Eigen::Vector3d(centre + scale.cwiseProduct(Eigen::Vector3d(v[0], v[1], v[2]) - centre))), false);
-      }
-      hull->recalcLocalAabb();
-      hull->setMargin(static_cast<btScalar>(margin_m));
-      shapes_.push_back(std::move(hull));
-    } else {
-      auto box = std::make_unique<btBoxShape>(bt(geometry_.box_half_extents_m));
-      box->setMargin(static_cast<btScalar>(margin_m));  // keeps the outer size
-      shapes_.push_back(std::move(box));
-    }
-    motion_states_.push_back(std::make_unique<btDefaultMotionState>(btTransform::getIdentity()));
-    auto body = std::make_unique<btRigidBody>(btRigidBody::btRigidBodyConstructionInfo(0, motion_states_.back().get(), shapes_.back().get()));
-    body->setCollisionFlags(body->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
-    body->setActivationState(DISABLE_DEACTIVATION);
-    body->setFriction(0);
-    parts_[static_cast<std::size_t>(p)] = std::move(body);
-  }
-  std::array<ToolPose, kMaxToolParts> start{};
-  tool_part_poses(scene, to_tool_pose(scene.trajectory.start), scene.trajectory.start_jaw_gap_m >= 0.0 ? scene.trajectory.start_jaw_gap_m : scene.tool.clamp.jaw_gap_open_m, start);
-  for (int p = 0; p < geometry_.part_count; ++p) {
-    btRigidBody& body = *parts_[static_cast<std::size_t>(p)];
-    body.setWorldTransform(bt(start[static_cast<std::size_t>(p)]));
-    body.getMotionState()->setWorldTransform(bt(start[static_cast<std::size_t>(p)]));
-    body.setInterpolationWorldTransform(bt(start[static_cast<std::size_t>(p)]));
-    if (parts_in_world_) world_->addRigidBody(&body);
+  make_tool_parts(scene);
+  if (parts_in_world_) {
+    for (int p = 0; p < geometry_.part_count; ++p) world_->addRigidBody(parts_[static_cast<std::size_t>(p)].get());
   }
 
   // [[soft_body.anchor]]: tie the selected rest nodes to the ground (the bed the tissue lies on).
@@ -220,6 +297,7 @@ SoftWorld::SoftWorld(const SceneDescription& scene, bool tool_collides_in_bullet
     // node-bounds solver does not reproduce.
     if (softs_.size() > 1) body->m_cfg.collisions = btSoftBody::fCollision::SDF_RS | btSoftBody::fCollision::VF_SS;
     world_->addSoftBody(body.get());
+    bodies_.push_back(body.get());
     first_nodes_.push_back(first_nodes_.back() + body->m_nodes.size());
   }
   if (probe_ != nullptr) {
@@ -263,6 +341,11 @@ void SoftWorld::teleport_part(int part, const ToolPose& pose) noexcept {
 }
 
 void SoftWorld::step(double h_s) noexcept {
+  if (fem_) {
+    const double substep_s = h_s / fem_substeps_;
+    for (int k = 0; k < fem_substeps_; ++k) fem_->step(substep_s);
+    return;
+  }
   if (probe_ != nullptr) probe_->clear();
   const auto h = static_cast<btScalar>(h_s);
   world_->stepSimulation(h, 1, h);
@@ -273,8 +356,8 @@ void SoftWorld::step(double h_s) noexcept {
 
 void SoftWorld::copy_node_positions(std::vector<Eigen::Vector3d>& out) const {
   out.resize(static_cast<std::size_t>(first_nodes_.back()));
-  for (std::size_t b = 0; b < softs_.size(); ++b) {
-    const btSoftBody& body = *softs_[b];
+  for (std::size_t b = 0; b < bodies_.size(); ++b) {
+    const btSoftBody& body = *bodies_[b];
     const auto first = static_cast<std::size_t>(first_nodes_[b]);
     for (int i = 0; i < body.m_nodes.size(); ++i) {
       const btVector3& x = body.m_nodes[i].m_x;

@@ -42,7 +42,7 @@ expect_refusal "field 'simulation.time_step_s': must be in [1e-06, 0.005] (got 0
 [[ $(cat "$work/sim.csv") == "earlier csv" ]] || bad "a refused fissure sim overwrote its --csv file"
 expect_refusal "at most 86400 s" sim spatula-sphere --seconds 1e9
 
-expect_refusal "known scenes: clamp-sphere, clamp-vessel, clamp-vessel-lift, clamp-vessel-retract, convex-spatula-sphere, spatula-ball-drag, spatula-blob, spatula-fissure, spatula-sphere" run no-such-scene --lockstep
+expect_refusal "known scenes: clamp-sphere, clamp-vessel, clamp-vessel-lift, clamp-vessel-retract, convex-spatula-sphere, spatula-ball-drag, spatula-blob, spatula-fem-lobe, spatula-fissure, spatula-sphere" run no-such-scene --lockstep
 expect_refusal "looked for $PWD/scenes/no-such-scene.toml" run no-such-scene --lockstep
 expect_refusal "is a directory, not a scene file" run "$work" --lockstep
 

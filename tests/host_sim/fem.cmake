@@ -4,3 +4,4 @@ fissure_add_test(host_sim_fem_material_test SOURCES fem_material_test.cpp LIBS f
 fissure_add_test(host_sim_tet_box_test SOURCES tet_box_test.cpp LIBS fissure_host_sim)
 fissure_add_test(host_sim_fem_body_test SOURCES fem_body_test.cpp LIBS fissure_host_sim)
 fissure_add_test(host_sim_fem_world_test SOURCES fem_world_test.cpp LIBS fissure_host_sim)
+fissure_add_test(host_sim_soft_world_fem_test SOURCES soft_world_fem_test.cpp LIBS fissure_host_sim)

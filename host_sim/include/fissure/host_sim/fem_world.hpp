@@ -60,6 +60,18 @@ struct FemWorldConfig {
   double sdf_voxel_m = 0.01;
 };
 
+/// The mesh's thinnest tetrahedron [m]: the smallest altitude over its largest face, 3V / A_max
+/// (+inf for a mesh without tetrahedra). A sliver (four nearly coplanar corners) has short
+/// altitudes with no short edge, and its stiffness is what limits the explicit step.
+[[nodiscard]] double thinnest_tetrahedron_m(const VolumeMesh& mesh) noexcept;
+
+/// The symplectic step's stable size [s]: a fraction (Courant number) of the P-wave's transit of
+/// the thinnest tetrahedron. 0.3·√2 gives a Kuhn grid of cubes (altitude a/√2) 0.3 × its edge,
+/// the step the tissue bench validated there; measured on TetGen's fill of the organ lobe
+/// (docs/decisions.md), where a shortest-edge criterion let slivers blow the body up.
+inline constexpr double kFemCourantRatio = 0.3 * 1.4142135623730951;
+[[nodiscard]] double fem_stable_step_s(const VolumeMesh& mesh, const FemMaterial& material, double courant = kFemCourantRatio) noexcept;
+
 class FemWorld {
  public:
   explicit FemWorld(const FemWorldConfig& config);

@@ -34,6 +34,8 @@ class btSoftBodyRigidBodyCollisionConfiguration;
 
 namespace fissure::host {
 
+class FemWorld;
+
 /// Half-extents of the tool's collidable parts in their own frames: the spatula box, the
 /// clamp's jaw box (both jaws), or the convex mesh's bounds. Part frames: thin axis local y.
 struct ToolPartGeometry {
@@ -60,11 +62,14 @@ class SoftWorld {
   SoftWorld(const SoftWorld&) = delete;
   SoftWorld& operator=(const SoftWorld&) = delete;
 
-  [[nodiscard]] btSoftRigidDynamicsWorld& world() noexcept { return *world_; }
   /// Soft body `body` of the scene's [[soft_body]] list (0: the first, the only one of most scenes).
-  [[nodiscard]] btSoftBody& soft(int body = 0) noexcept { return *softs_[static_cast<std::size_t>(body)]; }
-  [[nodiscard]] const btSoftBody& soft(int body = 0) const noexcept { return *softs_[static_cast<std::size_t>(body)]; }
-  [[nodiscard]] int soft_body_count() const noexcept { return static_cast<int>(softs_.size()); }
+  [[nodiscard]] btSoftBody& soft(int body = 0) noexcept { return *bodies_[static_cast<std::size_t>(body)]; }
+  [[nodiscard]] const btSoftBody& soft(int body = 0) const noexcept { return *bodies_[static_cast<std::size_t>(body)]; }
+  [[nodiscard]] int soft_body_count() const noexcept { return static_cast<int>(bodies_.size()); }
+  /// FEM bodies (model = "fem"): their world, and the symplectic substeps of each host step;
+  /// null and 1 for shells.
+  [[nodiscard]] const FemWorld* fem_world() const noexcept { return fem_.get(); }
+  [[nodiscard]] int fem_substeps() const noexcept { return fem_substeps_; }
   /// Where body `body`'s nodes start in copy_node_positions' concatenation (body_count: the total).
   [[nodiscard]] int first_node(int body) const noexcept { return first_nodes_[static_cast<std::size_t>(body)]; }
   [[nodiscard]] int part_count() const noexcept { return geometry_.part_count; }
@@ -87,13 +92,16 @@ class SoftWorld {
   /// for the next step (HostSimulation::reseat_tool; a kinematic body moved by set_part_pose
   /// would carry jump / dt into its contacts with the soft body).
   void teleport_part(int part, const ToolPose& pose) noexcept;
-  /// One Bullet step of h seconds (exactly one internal substep).
+  /// One Bullet step of h seconds (exactly one internal substep; FEM: fem_substeps() equal ones).
   void step(double h_s) noexcept;
   /// Copies every soft body's node positions (world, metres), body after body (first_node), into
   /// `out` (resized once).
   void copy_node_positions(std::vector<Eigen::Vector3d>& out) const;
 
  private:
+  void make_tool_parts(const SceneDescription& scene);
+  void build_fem_world(const SceneDescription& scene);
+
   ToolPartGeometry geometry_;
   double sdf_voxel_m_ = 0.0;
   std::unique_ptr<btSoftBodyRigidBodyCollisionConfiguration> configuration_;
@@ -108,7 +116,10 @@ class SoftWorld {
   std::vector<std::unique_ptr<btDefaultMotionState>> motion_states_;
   std::unique_ptr<btRigidBody> ground_;
   std::array<std::unique_ptr<btRigidBody>, kMaxToolParts> parts_;
-  std::vector<std::unique_ptr<btSoftBody>> softs_;
+  std::vector<std::unique_ptr<btSoftBody>> softs_;  // shells (the FEM world owns its bodies)
+  std::vector<btSoftBody*> bodies_;                 // every body, shell or FEM, in scene order
+  std::unique_ptr<FemWorld> fem_;
+  int fem_substeps_ = 1;
   std::vector<int> first_nodes_;  // per body, and the total last
   bool parts_in_world_ = false;
   int anchored_nodes_count_ = 0;

@@ -1,0 +1,166 @@
+// host_sim/src/soft_world.cpp (FEM bodies) through HostSimulation: a volumetric FEM body
+// (model = "fem", Bullet's deformable world) in the host simulation, met by the paired thin-body
+// contact after each step — the spatula-fem-lobe scene on a coarse block instead of the lobe, so
+// the test runs in a second. And fem_world.cpp's stable step, which sets the substeps.
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <BulletSoftBody/btSoftBody.h>
+
+#include "fissure/host_sim/fem_world.hpp"
+#include "fissure/host_sim/host_simulation.hpp"
+#include "fissure/host_sim/scene_loader.hpp"
+#include "fissure/host_sim/soft_world.hpp"
+#include "fissure/host_sim/tet_box.hpp"
+#include "tet_test_meshes.hpp"
+
+namespace fissure::host {
+namespace {
+
+const std::filesystem::path kScenes = "scenes";  // ctest runs in the source tree (scene_loader_test.cpp)
+
+std::string read(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string replace(std::string text, const std::string& from, const std::string& to) {
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+// The block: 60 × 20 × 60 mm of 10 mm Kuhn cells (147 nodes), its underside 2 mm above the
+// ground and fixed to it; the spatula starts 28 mm above its top.
+constexpr double kBlockTop_m = 0.022;
+
+class FemHost : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() / ("fissure-fem-host-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_);
+    block_ = test_tets::kuhn_box({6, 2, 6}, 0.01, {-0.03, 0.0, -0.03});
+    test_tets::write_vtk(block_, dir_ / "block.vtk");
+    std::string text = read(kScenes / "spatula-fem-lobe.toml");
+    text = replace(text, "\"meshes/organ-blob.1.node\"", "\"" + (dir_ / "block.vtk").string() + "\"");
+    text = replace(text, "offset_world_m = [0.0, 0.02075, 0.0]", "offset_world_m = [0.0, 0.002, 0.0]");
+    text = replace(text, "min_world_m = [-0.06, 0.0, -0.04]", "min_world_m = [-0.04, 0.0, -0.04]");
+    text = replace(text, "max_world_m = [0.06, 0.0035, 0.04]", "max_world_m = [0.04, 0.0025, 0.04]");
+    text = replace(text, "start_position_world_m = [0.0, 0.07, 0.0]", "start_position_world_m = [0.0, 0.05, 0.0]");
+    scene_text_ = text;
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  [[nodiscard]] SceneDescription scene(const std::string& text) const { return load_scene_text(text, "fem-block.toml", kScenes); }
+
+  std::filesystem::path dir_;
+  TetMesh block_;
+  std::string scene_text_;
+};
+
+TEST_F(FemHost, TheSpatulaPressesTheFemBlockWithNoCrossedNodeAndAForceThatGrowsWithDepth) {
+  const SceneDescription description = scene(scene_text_);
+  ASSERT_EQ(description.soft_bodies.front().model, SoftBodyModel::kFem);
+  HostSimulation sim(description);
+  ASSERT_NE(sim.world().fem_world(), nullptr);
+  // The substeps follow the stable step of the block's thinnest tetrahedron.
+  const VolumeMesh mesh{std::get<SoftMesh>(description.soft_bodies.front().shape).vertices_world_m, block_.tetrahedra, {}};
+  const int substeps = static_cast<int>(std::ceil(description.simulation.time_step_s / fem_stable_step_s(mesh, description.soft_bodies.front().fem)));
+  EXPECT_EQ(sim.world().fem_substeps(), substeps);
+  EXPECT_GE(substeps, 1);
+  const int fixed = sim.world().anchored_nodes_count();
+  EXPECT_EQ(fixed, 49);  // the 7 × 7 nodes of the underside
+
+  sim.settle(0.3);
+  const btSoftBody& soft = sim.world().soft();
+  double top_m = 0.0;
+  for (int i = 0; i < soft.m_nodes.size(); ++i) top_m = std::max(top_m, static_cast<double>(soft.m_nodes[i].m_x.y()));
+  EXPECT_LT(top_m, kBlockTop_m);           // it sags under its weight ...
+  EXPECT_GT(top_m, kBlockTop_m - 0.004);  // ... a little (E 3 kPa, 20 mm thick, fixed underneath)
+
+  // Down at 5 cm/s until the spatula's lower face (1 mm below its centre) is 6 mm below the top.
+  const double half_thickness_m = 0.001, speed_m_per_s = 0.05, dt = description.simulation.time_step_s;
+  ToolPose pose = sim.tool_pose();
+  double force_at_3mm = -1.0, force_at_6mm = -1.0;
+  int crossed_max = 0;
+  bool finite = true;
+  for (int i = 0; i < 2000; ++i) {
+    pose.position_world_m.y() -= speed_m_per_s * dt;
+    const HostStepResult& r = sim.step(pose);
+    crossed_max = std::max(crossed_max, r.crossing.crossed_nodes);
+    finite = finite && r.force_on_tool_world_n.allFinite();
+    const double depth_m = top_m - (pose.position_world_m.y() - half_thickness_m);
+    if (force_at_3mm < 0.0 && depth_m >= 0.003) force_at_3mm = r.force_on_tool_world_n.y();
+    if (depth_m >= 0.006) {
+      force_at_6mm = r.force_on_tool_world_n.y();
+      break;
+    }
+  }
+  EXPECT_EQ(crossed_max, 0);
+  EXPECT_TRUE(finite);
+  EXPECT_GT(force_at_3mm, 0.0);           // the tissue pushes the tool up
+  EXPECT_GT(force_at_6mm, force_at_3mm);  // and harder the deeper it goes
+  // Held there, the body does not creep through the tool, and the fixed underside stays put.
+  double held_force_n = 0.0;
+  for (int i = 0; i < 200; ++i) {
+    const HostStepResult& r = sim.step(pose);
+    crossed_max = std::max(crossed_max, r.crossing.crossed_nodes);
+    held_force_n = r.force_on_tool_world_n.y();
+  }
+  EXPECT_EQ(crossed_max, 0);
+  EXPECT_GT(held_force_n, 0.0);
+  int unmoved = 0;
+  for (int i = 0; i < soft.m_nodes.size(); ++i) {
+    if (soft.m_nodes[i].m_im != 0) continue;
+    const Vec3& rest = block_.vertices_m[static_cast<std::size_t>(i)];
+    unmoved += std::abs(static_cast<double>(soft.m_nodes[i].m_x.y()) - (rest[1] + 0.002)) < 1e-6 ? 1 : 0;
+  }
+  EXPECT_EQ(unmoved, fixed);
+}
+
+TEST_F(FemHost, InSolverContactBulletsMethodAndAShellBesideAnFemBodyAreRefused) {
+  const auto error_of = [](const SceneDescription& s, std::optional<SceneCollisionMethod> method = std::nullopt) {
+    try {
+      HostSimulation sim(s, method);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string in_solver = replace(scene_text_, "collision_method = \"paired\"", "collision_method = \"paired\"\ncontact_response = \"in_solver\"");
+  EXPECT_NE(error_of(scene(in_solver)).find("an FEM body (model = \"fem\") takes contact_response = \"after_step\""), std::string::npos) << error_of(scene(in_solver));
+  EXPECT_NE(error_of(scene(scene_text_), SceneCollisionMethod::kBullet).find("meets the tool through the paired or ray method"), std::string::npos);
+  // A second body, a shell: the two models live in different Bullet worlds.
+  SceneDescription mixed = scene(scene_text_);
+  SoftBodyDescription shell = load_scene(resolve_scene_path("spatula-sphere")).soft_bodies.front();
+  mixed.soft_bodies.push_back(shell);
+  EXPECT_NE(error_of(mixed).find("an FEM body (model = \"fem\") and a shell cannot share a scene"), std::string::npos) << error_of(mixed);
+}
+
+TEST(FemStableStep, AKuhnCubeKeepsThreeTenthsOfItsEdgeAndASliverIsThin) {
+  // A Kuhn cell's thinnest tetrahedron: altitude a/√2 over its largest face (legs a and a√2).
+  const VolumeMesh cube = make_tet_box(even_coordinates(0.0, 0.01, 1), even_coordinates(0.0, 0.01, 1), even_coordinates(0.0, 0.01, 1));
+  EXPECT_NEAR(thinnest_tetrahedron_m(cube), 0.01 / std::sqrt(2.0), 1e-15);
+  FemMaterial material;
+  EXPECT_NEAR(fem_stable_step_s(cube, material), 0.3 * 0.01 / p_wave_speed_m_per_s(material), 1e-15);
+  // Four corners 0.1 mm out of one plane, every edge ≥ 10 mm: the altitude says what the edges do not.
+  VolumeMesh sliver;
+  sliver.vertices_m = {Vec3{0.0, 0.0, 0.0}, Vec3{0.01, 0.0, 0.0}, Vec3{0.01, 0.01, 0.0001}, Vec3{0.0, 0.01, 0.0}};
+  sliver.tetrahedra = {{0, 1, 2, 3}};
+  EXPECT_LT(thinnest_tetrahedron_m(sliver), 1e-4);
+  EXPECT_GT(thinnest_tetrahedron_m(sliver), 0.0);
+}
+
+}  // namespace
+}  // namespace fissure::host
