@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -97,6 +98,50 @@ VolumeMesh make_tet_box(const std::vector<double>& xs, const std::vector<double>
   for (int k = 0; k + 1 < nz; ++k) {
     for (int j = 0; j + 1 < ny; ++j) {
       for (int i = 0; i + 1 < nx; ++i) {
+        int corner[8];
+        for (int b = 0; b < 8; ++b) corner[b] = index(i + (b & 1), j + ((b >> 1) & 1), k + ((b >> 2) & 1));
+        for (const auto& t : kKuhn) {
+          std::array<int, 4> q{corner[t[0]], corner[t[1]], corner[t[2]], corner[t[3]]};
+          const Eigen::Vector3d a = e3(q[0]);
+          if ((e3(q[1]) - a).dot((e3(q[2]) - a).cross(e3(q[3]) - a)) < 0.0) std::swap(q[2], q[3]);
+          tet.tetrahedra.push_back(q);
+        }
+      }
+    }
+  }
+  return volume_mesh_from(std::move(tet));
+}
+
+VolumeMesh make_tet_tube(const TetTube& tube) {
+  if (!(tube.inner_radius_m > 0.0) || !(tube.outer_radius_m > tube.inner_radius_m) || !(tube.length_m > 0.0)) {
+    throw std::invalid_argument("make_tet_tube: needs 0 < inner radius < outer radius and a positive length");
+  }
+  if (tube.cells_through < 1 || tube.cells_around < 3 || tube.cells_along < 1) {
+    throw std::invalid_argument("make_tet_tube: needs >= 1 cell through the wall, >= 3 around and >= 1 along");
+  }
+  const int nr = tube.cells_through + 1, nt = tube.cells_around, nz = tube.cells_along + 1;
+  TetMesh tet;
+  tet.source = "tet tube " + std::to_string(tube.cells_through) + " x " + std::to_string(nt) + " x " + std::to_string(tube.cells_along);
+  tet.vertices_m.reserve(static_cast<std::size_t>(nr) * nt * nz);
+  for (int k = 0; k < nz; ++k) {
+    for (int j = 0; j < nt; ++j) {
+      // Angle from the lowest generator (−y), counter-clockwise seen from +z.
+      const double angle = -0.5 * std::numbers::pi + 2.0 * std::numbers::pi * j / nt;
+      for (int i = 0; i < nr; ++i) {
+        const double r = tube.inner_radius_m + (tube.outer_radius_m - tube.inner_radius_m) * i / (nr - 1);
+        tet.vertices_m.push_back({tube.centre_world_m[0] + r * std::cos(angle), tube.centre_world_m[1] + r * std::sin(angle),
+                                  tube.centre_world_m[2] - 0.5 * tube.length_m + tube.length_m * k / (nz - 1)});
+      }
+    }
+  }
+  // The cells of the (radial, around, along) index grid, split as make_tet_box's (Kuhn, the same
+  // diagonal on every shared face, across the seam from the last angle to the first too).
+  auto index = [&](int i, int j, int k) { return (k * nt + (j % nt)) * nr + i; };
+  constexpr int kKuhn[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
+  auto e3 = [&](int v) { const Vec3& p = tet.vertices_m[static_cast<std::size_t>(v)]; return Eigen::Vector3d(p[0], p[1], p[2]); };
+  for (int k = 0; k + 1 < nz; ++k) {
+    for (int j = 0; j < nt; ++j) {
+      for (int i = 0; i + 1 < nr; ++i) {
         int corner[8];
         for (int b = 0; b < 8; ++b) corner[b] = index(i + (b & 1), j + ((b >> 1) & 1), k + ((b >> 2) & 1));
         for (const auto& t : kKuhn) {

@@ -1,8 +1,9 @@
 // host_sim/src/tet_box.cpp: structured tetrahedral boxes — counts, orientation, volume, boundary,
-// graded coordinates, refusals.
+// graded coordinates, refusals; and the tube (make_tet_tube).
 #include "fissure/host_sim/tet_box.hpp"
 
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 
 #include <Eigen/Core>
@@ -62,6 +63,34 @@ TEST(TetBox, GradedCoordinatesAreSymmetricEvenInsideAndEndAtTheExtent) {
 TEST(TetBox, RefusesAnAxisThatIsNotIncreasing) {
   EXPECT_THROW((void)make_tet_box({0.0, 1.0}, {0.0, 0.0}, {0.0, 1.0}), std::invalid_argument);
   EXPECT_THROW((void)make_tet_box({0.0}, {0.0, 1.0}, {0.0, 1.0}), std::invalid_argument);
+}
+
+TEST(TetTube, CountsOrientationVolumeBoundaryAndTheSeam) {
+  TetTube tube;
+  tube.cells_through = 2;
+  tube.cells_around = 16;
+  tube.cells_along = 3;
+  const VolumeMesh m = make_tet_tube(tube);  // volume_mesh_from checks it: conforming, one volume, closed boundary
+  EXPECT_EQ(m.vertices_m.size(), static_cast<std::size_t>(3 * 16 * 4));
+  EXPECT_EQ(m.tetrahedra.size(), static_cast<std::size_t>(6 * 2 * 16 * 3));
+  // Inner and outer walls (2 per cell face, 16 × 3 each) and two end annuli (2 × 16 × 2 each).
+  EXPECT_EQ(m.boundary_triangles.size(), static_cast<std::size_t>(2 * (2 * 16 * 3) + 2 * (2 * 16 * 2)));
+  double volume = 0.0;
+  for (const auto& t : m.tetrahedra) {
+    const double v = signed_volume(m, t);
+    EXPECT_GT(v, 0.0);
+    volume += v;
+  }
+  // The annulus between two regular 16-gons: (n/2) sin(2π/n) (R² − r²) L.
+  const double polygon = 8.0 * std::sin(2.0 * std::numbers::pi / 16.0);
+  EXPECT_NEAR(volume, polygon * (0.015 * 0.015 - 0.013 * 0.013) * 0.06, 1e-12);
+  // Vertex (i, j, k) at index (k · around + j) · (through + 1) + i; j = 0 the lowest generator.
+  const Vec3& lowest_outer = m.vertices_m[2];
+  EXPECT_NEAR(lowest_outer[0], 0.0, 1e-15);
+  EXPECT_NEAR(lowest_outer[1], -0.015, 1e-15);
+  EXPECT_NEAR(lowest_outer[2], -0.03, 1e-15);
+  EXPECT_THROW((void)make_tet_tube(TetTube{0.015, 0.013, 0.06, {0.0, 0.0, 0.0}, 2, 16, 3}), std::invalid_argument);
+  EXPECT_THROW((void)make_tet_tube(TetTube{0.013, 0.015, 0.06, {0.0, 0.0, 0.0}, 2, 2, 3}), std::invalid_argument);
 }
 
 }  // namespace

@@ -15,6 +15,9 @@ namespace fissure::eval {
 
 /// The tissue the validations use unless told otherwise: liver-like (fem_material.hpp's sources).
 [[nodiscard]] host::FemMaterial validation_tissue();
+/// A vessel wall for the ovalisation check: E 0.5 MPa (arterial wall at low strain, elastin-
+/// dominated: ~0.3–1 MPa, docs/scenes.md), ν 0.45, 1040 kg/m³.
+[[nodiscard]] host::FemMaterial validation_vessel_wall();
 
 // ---- Uniaxial compression of a cube between two frictionless rigid plates (tissue_cube.cpp).
 struct CubeCompressionOptions {
@@ -80,6 +83,34 @@ struct CantileverResult {
   double max_speed_m_per_s = 0.0;
 };
 [[nodiscard]] CantileverResult run_cantilever(const CantileverOptions& options);
+
+// ---- A vessel resting on the ground (tissue_vessel.cpp): the section's ovalisation under the
+// tube's own weight, against Roark's thin ring supported at its base (Table 9.2 case 15):
+// ΔD_V = −0.4674 w R⁴ / (E I), ΔD_H = +0.4292 w R⁴ / (E I), per unit length of a long tube
+// w = ρ g t and E I = E t³ / (12 (1 − ν²)) (plane strain), R the mean radius.
+struct VesselOptions {
+  double inner_radius_m = 0.013;     ///< the shipped vessel's 15 mm outer radius, a 2 mm wall
+  double outer_radius_m = 0.015;
+  double length_m = 0.06;
+  int cells_through = 2;
+  int cells_around = 32;
+  int cells_along = 12;
+  host::FemMaterial material = validation_vessel_wall();
+};
+struct VesselResult {
+  int nodes_count = 0;
+  int tetrahedra_count = 0;
+  int steps_count = 0;
+  double vertical_change_m = 0.0;    ///< outer vertical diameter at mid-length, settled − rest (< 0: flattened)
+  double horizontal_change_m = 0.0;  ///< outer horizontal diameter, settled − rest (> 0: spread)
+  double expected_vertical_change_m = 0.0;
+  double expected_horizontal_change_m = 0.0;
+  double vertical_relative_error = 0.0;    ///< measured / Roark − 1
+  double horizontal_relative_error = 0.0;
+  double ovalisation = 0.0;          ///< (D_H − D_V) / D_rest at mid-length, settled
+  double max_speed_m_per_s = 0.0;
+};
+[[nodiscard]] VesselResult run_vessel_on_ground(const VesselOptions& options);
 
 // ---- Cost of one host step against node count (tissue_step_cost.cpp): a block resting on the
 // ground under gravity.

@@ -29,4 +29,20 @@ namespace fissure::host {
 /// `spacing_m` below hi, then cells growing by `growth` towards lo (the punched block's depth).
 [[nodiscard]] std::vector<double> graded_coordinates_down(double lo_m, double hi_m, double fine_depth_m, double spacing_m, double growth);
 
+/// A straight tube along world z (a vessel's wall as a volume): the annulus inner_radius ..
+/// outer_radius, `length_m` long, centred at `centre_world_m`; a structured grid of cells_through
+/// × cells_around × cells_along cells split as make_tet_box's. Vertex (i radial, j around, k along)
+/// has index (k · cells_around + j) · (cells_through + 1) + i; j = 0 is the lowest generator
+/// (−y), angles counter-clockwise seen from +z. Throws std::invalid_argument for a bad size.
+struct TetTube {
+  double inner_radius_m = 0.013;
+  double outer_radius_m = 0.015;
+  double length_m = 0.06;
+  Vec3 centre_world_m{0.0, 0.0, 0.0};
+  int cells_through = 2;
+  int cells_around = 32;
+  int cells_along = 20;
+};
+[[nodiscard]] VolumeMesh make_tet_tube(const TetTube& tube);
+
 }  // namespace fissure::host
