@@ -273,6 +273,7 @@ const HostStepResult& HostSimulation::step(const ToolPose& tool_target, double j
       result_.times.bullet_s -= r.seconds_in_solver;
       if (bodies > 1) accumulate(r, body, result_.part_results[k]);
     }
+    world_->end_step();
     previous = part_poses_;
     // The metrics follow every sub-step: the crossing tracker judges each node's relative path
     // between two updates as a straight line, which is the collision's own model of one

@@ -207,6 +207,7 @@ void SoftWorld::build_fem_world(const SceneDescription& scene) {
     first_nodes_.push_back(first_nodes_.back() + fem_->body(b).m_nodes.size());
   }
   sdf_voxel_m_ = config.sdf_voxel_m;
+  fem_start_x_.resize(static_cast<std::size_t>(first_nodes_.back()));
   fem_substeps_ = std::max(1, static_cast<int>(std::ceil(host_step_s / stable_step_s)));
   if (fem_substeps_ > kFemMaxSubsteps) {
     throw std::invalid_argument("[soft_body] model = \"fem\": a " + std::to_string(host_step_s * 1e3) + " ms step needs " + std::to_string(fem_substeps_) +
@@ -342,8 +343,20 @@ void SoftWorld::teleport_part(int part, const ToolPose& pose) noexcept {
 
 void SoftWorld::step(double h_s) noexcept {
   if (fem_) {
+    // Bullet's deformable step ends with m_q = m_x (btDeformableBodySolver's integration), and the
+    // thin-body sweep reads m_q as where a node started the step: without this, a node's own
+    // motion over the step would be invisible to it (a body springing back through a thin tool at
+    // 10 m/s crossed it: 15 nodes on a 147-node block). end_step() gives Bullet its m_q back.
+    std::size_t i = 0;
+    for (const btSoftBody* body : bodies_) {
+      for (int n = 0; n < body->m_nodes.size(); ++n) fem_start_x_[i++] = body->m_nodes[n].m_x;
+    }
     const double substep_s = h_s / fem_substeps_;
     for (int k = 0; k < fem_substeps_; ++k) fem_->step(substep_s);
+    i = 0;
+    for (btSoftBody* body : bodies_) {
+      for (int n = 0; n < body->m_nodes.size(); ++n) body->m_nodes[n].m_q = fem_start_x_[i++];
+    }
     return;
   }
   if (probe_ != nullptr) probe_->clear();
@@ -352,6 +365,15 @@ void SoftWorld::step(double h_s) noexcept {
   // The sparse SDF caches cells per shape; drop the ones not used for a while (as Bullet's
   // demos do every frame) so a long run does not hit the cell cap and reset.
   world_->getWorldInfo().m_sparsesdf.GarbageCollect();
+}
+
+void SoftWorld::end_step() noexcept {
+  if (!fem_) return;
+  // The next deformable step evaluates the elastic force at m_q, which its integration left at
+  // m_x (x_n): as it was, with the contact's placement of the nodes.
+  for (btSoftBody* body : bodies_) {
+    for (int n = 0; n < body->m_nodes.size(); ++n) body->m_nodes[n].m_q = body->m_nodes[n].m_x;
+  }
 }
 
 void SoftWorld::copy_node_positions(std::vector<Eigen::Vector3d>& out) const {

@@ -17,6 +17,8 @@
 
 #include <Eigen/Core>
 
+#include <LinearMath/btVector3.h>
+
 #include "fissure/host_sim/bullet_collision.hpp"
 #include "fissure/host_sim/node_bounds_solver.hpp"
 #include "fissure/host_sim/scene_description.hpp"
@@ -93,7 +95,12 @@ class SoftWorld {
   /// would carry jump / dt into its contacts with the soft body).
   void teleport_part(int part, const ToolPose& pose) noexcept;
   /// One Bullet step of h seconds (exactly one internal substep; FEM: fem_substeps() equal ones).
+  /// Every node's m_q is then where it was when the step began (Bullet's classic solver leaves it
+  /// so; the FEM world is made to), which the thin-body sweep reads as the node's start.
   void step(double h_s) noexcept;
+  /// After the contact response of a step: FEM bodies get m_q = m_x back, which Bullet's next
+  /// deformable step reads as the node's position (no-op for shells).
+  void end_step() noexcept;
   /// Copies every soft body's node positions (world, metres), body after body (first_node), into
   /// `out` (resized once).
   void copy_node_positions(std::vector<Eigen::Vector3d>& out) const;
@@ -120,6 +127,7 @@ class SoftWorld {
   std::vector<btSoftBody*> bodies_;                 // every body, shell or FEM, in scene order
   std::unique_ptr<FemWorld> fem_;
   int fem_substeps_ = 1;
+  std::vector<btVector3> fem_start_x_;  // FEM: every node's position when the host step began (step())
   std::vector<int> first_nodes_;  // per body, and the total last
   bool parts_in_world_ = false;
   int anchored_nodes_count_ = 0;
