@@ -21,9 +21,6 @@ namespace {
 constexpr double kGravityMPerS2 = 9.81;
 // Quasi-static solve (tissue_detail.hpp settle_implicit): the default beam's first period is
 // ~90 ms; the tolerance is ~1e-5 of its ~3 mm sag per second.
-constexpr double kImplicitStepS = 1.0;
-constexpr int kNewtonIterations = 3;
-constexpr int kCgMaxIterations = 5000;
 constexpr int kMaxSteps = 30;
 constexpr double kSpeedToleranceMPerS = 3e-8;
 
@@ -34,11 +31,7 @@ CantileverResult run_cantilever(const CantileverOptions& o) {
   const int along = static_cast<int>(std::lround(o.cells_across * l / b));
   const host::VolumeMesh mesh = host::make_tet_box(host::even_coordinates(0.0, l, along), host::even_coordinates(-0.5 * b, 0.5 * b, o.cells_across),
                                                    host::even_coordinates(-0.5 * b, 0.5 * b, o.cells_across));
-  host::FemWorldConfig config;
-  config.implicit = true;
-  config.newton_iterations = kNewtonIterations;
-  config.cg_max_iterations = kCgMaxIterations;
-  config.gravity_world_m_per_s2 = Eigen::Vector3d(0.0, -kGravityMPerS2, 0.0);
+  const host::FemWorldConfig config = quasi_static_config(Eigen::Vector3d(0.0, -kGravityMPerS2, 0.0));
   host::FemWorld world(config);
   const int body = world.add_body(mesh, o.material, host::FemContact{});
   world.fix_nodes(body, nodes_where(mesh, [&](const Eigen::Vector3d& p) { return p.x() <= 1e-9 * l; }));
@@ -47,7 +40,7 @@ CantileverResult run_cantilever(const CantileverOptions& o) {
   CantileverResult r;
   r.nodes_count = static_cast<int>(mesh.vertices_m.size());
   r.tetrahedra_count = static_cast<int>(mesh.tetrahedra.size());
-  r.steps_count = settle_implicit(world, body, kImplicitStepS, kMaxSteps, kSpeedToleranceMPerS);
+  r.steps_count = settle_implicit(world, body, kQuasiStaticStepS, kMaxSteps, kSpeedToleranceMPerS);
   double sag = 0.0;
   for (int n : tip) sag += mesh.vertices_m[static_cast<std::size_t>(n)][1] - world.node_position_m(body, n).y();
   r.tip_deflection_m = sag / static_cast<double>(tip.size());

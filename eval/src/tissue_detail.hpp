@@ -36,6 +36,20 @@ inline Eigen::Vector3d sum_over(const std::vector<Eigen::Vector3d>& f, const std
   return s;
 }
 
+/// Bullet's implicit step as a quasi-static solver (the punch, the cantilever, the vessel): steps
+/// of kQuasiStaticStepS, far above the specimens' slowest periods (~0.02–0.1 s), each with 3
+/// Newton iterations whose CG may run to 5,000 (Bullet's cap of 300 left the cantilever's tip 6 %
+/// short: docs/decisions.md). Gravity as given (zero: none).
+inline constexpr double kQuasiStaticStepS = 1.0;
+inline host::FemWorldConfig quasi_static_config(const Eigen::Vector3d& gravity_world_m_per_s2 = Eigen::Vector3d::Zero()) {
+  host::FemWorldConfig config;
+  config.implicit = true;
+  config.newton_iterations = 3;
+  config.cg_max_iterations = 5000;
+  config.gravity_world_m_per_s2 = gravity_world_m_per_s2;
+  return config;
+}
+
 /// Quasi-static solve with Bullet's implicit step (fem_world.hpp): steps of `step_s` until every
 /// node of the body moves slower than `speed_tolerance_m_per_s` (the state no longer changes by
 /// more than that × step per step) or `max_steps` are done. Backward Euler at a step near the

@@ -27,9 +27,6 @@ namespace {
 constexpr double kFineRadii = 1.5;
 // Quasi-static solve per depth (tissue_detail.hpp settle_implicit): the block's slowest period
 // is ~0.1 s at 5 kPa; the tolerance is 1e-3 of the smallest depth per second.
-constexpr double kImplicitStepS = 1.0;
-constexpr int kNewtonIterations = 3;
-constexpr int kCgMaxIterations = 5000;
 constexpr int kMaxStepsPerDepth = 30;
 constexpr double kSpeedToleranceMPerS = 1e-7;
 
@@ -39,10 +36,7 @@ FlatPunchResult run_flat_punch(const FlatPunchOptions& o) {
   const double a = o.punch_radius_m, w = o.block_half_width_radii * a, h = a / o.cells_per_radius;
   const std::vector<double> xz = host::graded_coordinates(kFineRadii * a, h, w, o.growth);
   const host::VolumeMesh mesh = host::make_tet_box(xz, host::graded_coordinates_down(-w, 0.0, kFineRadii * a, h, o.growth), xz);
-  host::FemWorldConfig config;
-  config.implicit = true;
-  config.newton_iterations = kNewtonIterations;
-  config.cg_max_iterations = kCgMaxIterations;
+  const host::FemWorldConfig config = quasi_static_config();
   host::FemWorld world(config);
   const int body = world.add_body(mesh, o.material, host::FemContact{});
   const std::vector<int> punch = nodes_where(mesh, [&](const Eigen::Vector3d& p) {
@@ -62,7 +56,7 @@ FlatPunchResult run_flat_punch(const FlatPunchOptions& o) {
       const Vec3& p = mesh.vertices_m[static_cast<std::size_t>(n)];
       world.move_fixed_node(body, n, Eigen::Vector3d(p[0], p[1] - d, p[2]));
     }
-    r.steps_count += settle_implicit(world, body, kImplicitStepS, kMaxStepsPerDepth, kSpeedToleranceMPerS);
+    r.steps_count += settle_implicit(world, body, kQuasiStaticStepS, kMaxStepsPerDepth, kSpeedToleranceMPerS);
     world.elastic_forces(body, force);
     r.forces_n.push_back(sum_over(force, punch).y());  // the block pushes the punch up: + y
   }

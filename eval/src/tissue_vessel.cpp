@@ -37,9 +37,6 @@ constexpr double kRoarkVertical = -0.4674;
 constexpr double kRoarkHorizontal = 0.4292;
 // Quasi-static solve, as the cantilever's: the ring's first bending period is ~20 ms for the
 // default wall; the tolerance is ~1e-5 of its ~1 mm change per second.
-constexpr double kImplicitStepS = 1.0;
-constexpr int kNewtonIterations = 3;
-constexpr int kCgMaxIterations = 5000;
 constexpr int kMaxSteps = 30;
 constexpr double kSpeedToleranceMPerS = 1e-8;
 
@@ -55,11 +52,7 @@ VesselResult run_vessel_on_ground(const VesselOptions& o) {
   tube.cells_around = o.cells_around;
   tube.cells_along = o.cells_along;
   const host::VolumeMesh mesh = host::make_tet_tube(tube);
-  host::FemWorldConfig config;
-  config.implicit = true;
-  config.newton_iterations = kNewtonIterations;
-  config.cg_max_iterations = kCgMaxIterations;
-  config.gravity_world_m_per_s2 = Eigen::Vector3d(0.0, -kGravityMPerS2, 0.0);
+  const host::FemWorldConfig config = quasi_static_config(Eigen::Vector3d(0.0, -kGravityMPerS2, 0.0));
   host::FemWorld world(config);
   const int body = world.add_body(mesh, o.material, host::FemContact{});
   // make_tet_tube's numbering: vertex (i radial, j around from the lowest generator, k along).
@@ -81,7 +74,7 @@ VesselResult run_vessel_on_ground(const VesselOptions& o) {
   const int bottom = vertex(nr - 1, 0, mid), right = vertex(nr - 1, nt / 4, mid), top = vertex(nr - 1, nt / 2, mid), left = vertex(nr - 1, 3 * nt / 4, mid);
   const auto rest = [&](int v) { return e3(mesh.vertices_m[static_cast<std::size_t>(v)]); };
   const double rest_vertical = rest(top).y() - rest(bottom).y(), rest_horizontal = rest(right).x() - rest(left).x();
-  r.steps_count = settle_implicit(world, body, kImplicitStepS, kMaxSteps, kSpeedToleranceMPerS);
+  r.steps_count = settle_implicit(world, body, kQuasiStaticStepS, kMaxSteps, kSpeedToleranceMPerS);
   const double vertical = world.node_position_m(body, top).y() - world.node_position_m(body, bottom).y();
   const double horizontal = world.node_position_m(body, right).x() - world.node_position_m(body, left).x();
   r.vertical_change_m = vertical - rest_vertical;

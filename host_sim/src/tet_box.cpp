@@ -2,6 +2,7 @@
 #include "fissure/host_sim/tet_box.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -44,6 +45,24 @@ std::vector<double> grow(double start, double end, double first, double growth) 
     }
   }
   return out;
+}
+
+// The 6 Kuhn tetrahedra of a cell whose corner b = (b & 1, (b >> 1) & 1, (b >> 2) & 1) is vertex
+// corner[b]: each path from corner 0 to corner 7 along the three axes in one order, turned
+// positive. Every cell split so shares the diagonal of each face with its neighbour.
+void append_kuhn_cell(TetMesh& tet, const std::array<int, 8>& corner) {
+  constexpr int kKuhn[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
+  const auto e3 = [&tet](int v) {
+    const Vec3& p = tet.vertices_m[static_cast<std::size_t>(v)];
+    return Eigen::Vector3d(p[0], p[1], p[2]);
+  };
+  for (const auto& t : kKuhn) {
+    std::array<int, 4> q{corner[static_cast<std::size_t>(t[0])], corner[static_cast<std::size_t>(t[1])], corner[static_cast<std::size_t>(t[2])],
+                         corner[static_cast<std::size_t>(t[3])]};
+    const Eigen::Vector3d a = e3(q[0]);
+    if ((e3(q[1]) - a).dot((e3(q[2]) - a).cross(e3(q[3]) - a)) < 0.0) std::swap(q[2], q[3]);
+    tet.tetrahedra.push_back(q);
+  }
 }
 
 }  // namespace
@@ -90,22 +109,13 @@ VolumeMesh make_tet_box(const std::vector<double>& xs, const std::vector<double>
     }
   }
   auto index = [&](int i, int j, int k) { return (k * ny + j) * nx + i; };
-  // The 6 Kuhn tetrahedra of a cell: corner b = (b & 1, (b >> 1) & 1, (b >> 2) & 1), each path
-  // from corner 0 to corner 7 along the three axes in one order.
-  constexpr int kKuhn[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
   tet.tetrahedra.reserve(6 * static_cast<std::size_t>(nx - 1) * (ny - 1) * (nz - 1));
-  auto e3 = [&](int v) { const Vec3& p = tet.vertices_m[static_cast<std::size_t>(v)]; return Eigen::Vector3d(p[0], p[1], p[2]); };
   for (int k = 0; k + 1 < nz; ++k) {
     for (int j = 0; j + 1 < ny; ++j) {
       for (int i = 0; i + 1 < nx; ++i) {
-        int corner[8];
-        for (int b = 0; b < 8; ++b) corner[b] = index(i + (b & 1), j + ((b >> 1) & 1), k + ((b >> 2) & 1));
-        for (const auto& t : kKuhn) {
-          std::array<int, 4> q{corner[t[0]], corner[t[1]], corner[t[2]], corner[t[3]]};
-          const Eigen::Vector3d a = e3(q[0]);
-          if ((e3(q[1]) - a).dot((e3(q[2]) - a).cross(e3(q[3]) - a)) < 0.0) std::swap(q[2], q[3]);
-          tet.tetrahedra.push_back(q);
-        }
+        std::array<int, 8> corner{};
+        for (int b = 0; b < 8; ++b) corner[static_cast<std::size_t>(b)] = index(i + (b & 1), j + ((b >> 1) & 1), k + ((b >> 2) & 1));
+        append_kuhn_cell(tet, corner);
       }
     }
   }
@@ -134,22 +144,16 @@ VolumeMesh make_tet_tube(const TetTube& tube) {
       }
     }
   }
-  // The cells of the (radial, around, along) index grid, split as make_tet_box's (Kuhn, the same
-  // diagonal on every shared face, across the seam from the last angle to the first too).
+  // The cells of the (radial, around, along) index grid, split as make_tet_box's, across the seam
+  // from the last angle to the first too.
   auto index = [&](int i, int j, int k) { return (k * nt + (j % nt)) * nr + i; };
-  constexpr int kKuhn[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
-  auto e3 = [&](int v) { const Vec3& p = tet.vertices_m[static_cast<std::size_t>(v)]; return Eigen::Vector3d(p[0], p[1], p[2]); };
+  tet.tetrahedra.reserve(6 * static_cast<std::size_t>(nr - 1) * nt * (nz - 1));
   for (int k = 0; k + 1 < nz; ++k) {
     for (int j = 0; j < nt; ++j) {
       for (int i = 0; i + 1 < nr; ++i) {
-        int corner[8];
-        for (int b = 0; b < 8; ++b) corner[b] = index(i + (b & 1), j + ((b >> 1) & 1), k + ((b >> 2) & 1));
-        for (const auto& t : kKuhn) {
-          std::array<int, 4> q{corner[t[0]], corner[t[1]], corner[t[2]], corner[t[3]]};
-          const Eigen::Vector3d a = e3(q[0]);
-          if ((e3(q[1]) - a).dot((e3(q[2]) - a).cross(e3(q[3]) - a)) < 0.0) std::swap(q[2], q[3]);
-          tet.tetrahedra.push_back(q);
-        }
+        std::array<int, 8> corner{};
+        for (int b = 0; b < 8; ++b) corner[static_cast<std::size_t>(b)] = index(i + (b & 1), j + ((b >> 1) & 1), k + ((b >> 2) & 1));
+        append_kuhn_cell(tet, corner);
       }
     }
   }
