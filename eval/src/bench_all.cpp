@@ -91,6 +91,8 @@ std::vector<Child> children(const fs::path& out_dir) {
       {"mesh", {"bench", "mesh"}, {}, {"--quick"}, 60, 2},
       // Grasp, lift, slip and pull-out with friction (issue 23).
       {"grasp", {"bench", "grasp"}, {}, {"--quick"}, 12, 10},
+      // FEM tissue against its analytic anchors and its cost per host step (issue 24).
+      {"tissue", {"bench", "tissue"}, {}, {"--quick"}, 350, 30},
       {"pareto", {"bench", "pareto"}, {}, {"--quick", "--repeats", "1"}, 12, 4},
       {"view", {"bench", "view"}, {"--out", view_runs}, {"--repeats", "1", "--out", view_runs}, 25, 9},
       // The ci profile in both modes (the report carries its summary): 80-260 s on the loaded VM.

@@ -40,6 +40,7 @@ REQUIRED_SECTIONS = [
     "## Z-width against tick rate",
     "## Stress summary",
     "## Mesh import",
+    "## Tissue: FEM against analytic anchors",
 ]
 
 failures = []
@@ -137,6 +138,10 @@ def main():
             "full profile passes (every case, ≥ 1e6 rt ticks each)": "not checked",  # no stress_full.json
             # 41 160 → 361 600 triangles, 0.34 → 3.26 s: exponent 1.04
             "convex tool mesh load time grows at most as n log n (exponent ≤ 1.1 between the two largest meshes)": "met",
+            # tissue.json (a full `fissure bench tissue` run): the bench's own checks, shown as judged
+            "vessel ovalisation on the ground (finest)": "met",                  # 1.84 % (bound 10 %)
+            "vessel flattening / Roark - 1 (finest)": "**MISSED**",              # -65.8 % (locking)
+            "ms per step near 4,807 nodes": "**MISSED**",                        # 20.8 ms (bound 2 ms)
         }
         in_solver_expectations = {
             "in_solver, tool friction 0.5 / 0.4: paired: 0 triangles cut deeper than 0.1 mm (both sweep meshes over the hold; levering and clamp cells over every step)": "met",

@@ -32,7 +32,7 @@ from targets import IN_SOLVER_VARIANTS, MET, MISSED, NOT_CHECKED, Target, evalua
 REGENERATE = "build/bin/fissure bench all --out out/bench --docs docs --stress-full"
 
 BENCHMARKS = ["kinematics", "rt", "collision", "collision_in_solver", "collision_in_solver_frictionless", "proxy", "pareto", "view",
-              "stress", "stress_full", "mesh", "grasp"]
+              "stress", "stress_full", "mesh", "grasp", "tissue"]
 # `fissure render` children of bench all: one PNG frame each of the 10 m/s plunge.
 PLUNGE_FRAMES = {"plunge_bullet": "plunge-bullet", "plunge_paired": "plunge-paired"}
 
@@ -902,8 +902,40 @@ def section_grasp(report, data, problems, targets):
     report.add(targets_table([t for t in targets if t.section == "grasp"]))
 
 
+def section_tissue(report, data, problems, targets):
+    report.add("## Tissue: FEM against analytic anchors — `fissure bench tissue`")
+    report.add("")
+    tissue = data.get("tissue")
+    if not tissue:
+        missing(report, "tissue", problems)
+        return
+    m = tissue["material"]
+    report.add("Bullet's deformable world (corotated linear elasticity unless named) on structured tetrahedral meshes, each "
+               "against its analytic anchor; tissue E = " + fmt(m["youngs_modulus_pa"]) + " Pa, ν = " + fmt(m["poisson_ratio"])
+               + " unless named" + (" (a --quick run: coarse meshes only)." if tissue.get("quick") else "."))
+    report.add("")
+    rows = [["cube 20 mm, 5 % strain, " + r["model"], f"{r['cells_per_edge']} cells / edge", r["nodes"], f"{fmt(r['force_n'])} N",
+             f"E·A·ε = {fmt(r['expected_force_n'])} N", f"{100 * r['relative_error']:+.2f} %"] for r in tissue["cube"]]
+    rows += [["flat punch a = 5 mm", f"{r['cells_per_radius']} cells / radius", r["nodes"], f"{fmt(r['slope_n_per_m'])} N/m",
+              f"2aE/(1−ν²) = {fmt(r['expected_slope_n_per_m'])} N/m", f"{100 * r['relative_error']:+.2f} %"] for r in tissue["punch"]]
+    rows += [["cantilever 100 × 10 × 10 mm, E 5 MPa", f"{r['cells_across']} cells across", r["nodes"], f"{fmt(1e3 * r['tip_deflection_m'])} mm",
+              f"qL⁴/8EI = {fmt(1e3 * r['expected_deflection_m'])} mm", f"{100 * r['relative_error']:+.2f} %"] for r in tissue["cantilever"]]
+    rows += [["vessel R 15 mm, wall 2 mm, on the ground", f"{r['cells_through']} × {r['cells_around']} × {r['cells_along']} cells", r["nodes"],
+              f"ΔD_V {fmt(1e3 * r['vertical_change_m'])} mm, ovalisation {100 * r['ovalisation']:.2f} %",
+              f"Roark ΔD_V = {fmt(1e3 * r['expected_vertical_change_m'])} mm", f"{100 * r['vertical_relative_error']:+.2f} %"]
+             for r in tissue.get("vessel", [])]
+    report.add(table(["specimen", "mesh", "nodes", "measured", "analytic", "error"], rows))
+    report.add("")
+    report.add("Cost of one 1 ms host step (a 40 mm tissue cube resting on the ground):")
+    report.add("")
+    report.add(table(["stepping", "nodes", "tetrahedra", "substeps", "median ms", "p95 ms", "highest host rate Hz"],
+                     [[r["stepping"], r["nodes"], r["tetrahedra"], r["substeps"], fmt(r["median_ms"]), fmt(r["p95_ms"]),
+                       fmt(r["highest_rate_hz"])] for r in tissue["step_cost"]]))
+    report.add(targets_table([t for t in targets if t.section == "tissue"]))
+
+
 SECTIONS = [section_pareto, section_tunnelling, section_contact_in_solver, section_scaling, section_rt, section_stress, section_view, section_mesh,
-            section_grasp]
+            section_grasp, section_tissue]
 
 
 def main():
