@@ -62,7 +62,7 @@ CubeCompressionResult run_cube_compression(const CubeCompressionOptions& o) {
   CubeCompressionResult r;
   r.nodes_count = static_cast<int>(mesh.vertices_m.size());
   r.tetrahedra_count = static_cast<int>(mesh.tetrahedra.size());
-  r.step_s = stable_step_s(mesh, material);
+  r.step_s = host::fem_stable_step_s(mesh, material);
   const double period_s = 4.0 * l / bar_speed;
   const auto steps_for = [&](double periods) { return static_cast<int>(std::ceil(periods * period_s / r.step_s)); };
   const std::vector<int> bottom = nodes_where(mesh, [&](const Eigen::Vector3d& p) { return p.y() <= 1e-9 * l; });

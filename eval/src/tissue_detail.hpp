@@ -25,11 +25,6 @@ inline std::vector<int> nodes_where(const host::VolumeMesh& mesh, const std::fun
   return out;
 }
 
-/// The symplectic step's stable size (host::fem_stable_step_s).
-inline double stable_step_s(const host::VolumeMesh& mesh, const host::FemMaterial& material, double courant = host::kFemCourantRatio) {
-  return host::fem_stable_step_s(mesh, material, courant);
-}
-
 inline Eigen::Vector3d sum_over(const std::vector<Eigen::Vector3d>& f, const std::vector<int>& nodes) {
   Eigen::Vector3d s = Eigen::Vector3d::Zero();
   for (int n : nodes) s += f[static_cast<std::size_t>(n)];

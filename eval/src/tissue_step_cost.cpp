@@ -29,7 +29,7 @@ StepCostResult time_fem_steps(const StepCostOptions& o) {
   StepCostResult r;
   r.nodes_count = static_cast<int>(mesh.vertices_m.size());
   r.tetrahedra_count = static_cast<int>(mesh.tetrahedra.size());
-  r.substeps = o.substeps > 0 ? o.substeps : (o.implicit ? 1 : static_cast<int>(std::ceil(o.step_s / tissue_detail::stable_step_s(mesh, o.material))));
+  r.substeps = o.substeps > 0 ? o.substeps : (o.implicit ? 1 : static_cast<int>(std::ceil(o.step_s / host::fem_stable_step_s(mesh, o.material))));
   const double substep_s = o.step_s / r.substeps;
   const auto host_step = [&] {
     for (int k = 0; k < r.substeps; ++k) world.step(substep_s);

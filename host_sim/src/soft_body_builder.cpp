@@ -362,6 +362,18 @@ std::vector<int> nodes_in_anchor_box(const std::vector<Vec3>& nodes_world_m, con
   return inside;
 }
 
+std::vector<int> anchored_nodes(const std::vector<Vec3>& nodes_world_m, const SoftBodyDescription& description) {
+  std::vector<int> out;
+  for (std::size_t b = 0; b < description.anchors.size(); ++b) {
+    const std::vector<int> selected = nodes_in_anchor_box(nodes_world_m, description.anchors[b]);
+    if (selected.empty()) throw std::invalid_argument("soft_body.anchor[" + std::to_string(b) + "] selects no soft node");
+    out.insert(out.end(), selected.begin(), selected.end());
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
 int anchor_soft_body(btSoftBody& body, btRigidBody& bed, const SoftBodyDescription& description) {
   if (description.anchors.empty()) return 0;
   std::vector<Vec3> nodes;
@@ -370,23 +382,15 @@ int anchor_soft_body(btSoftBody& body, btRigidBody& bed, const SoftBodyDescripti
     const btVector3& x = body.m_nodes[i].m_x;
     nodes.push_back({x.x(), x.y(), x.z()});
   }
-  std::vector<bool> anchored(nodes.size(), false);
-  int count = 0;
-  for (std::size_t b = 0; b < description.anchors.size(); ++b) {
-    const std::vector<int> selected = nodes_in_anchor_box(nodes, description.anchors[b]);
-    if (selected.empty()) throw std::invalid_argument("soft_body.anchor[" + std::to_string(b) + "] selects no soft node");
-    for (const int i : selected) {
-      if (anchored[static_cast<std::size_t>(i)]) continue;  // overlapping boxes: one anchor per node
-      anchored[static_cast<std::size_t>(i)] = true;
-      // disableCollisionBetweenLinkedBodies = false: that flag would switch off the contact of
-      // EVERY node with the bed (btSoftBody::m_collisionDisabledObjects is per body), and the
-      // free nodes must still land on it. Influence 1: the full anchor impulse (the anchor's
-      // stiffness is Bullet's kAHR, default 0.7 of the offset per solver pass).
-      body.appendAnchor(i, &bed, false, 1);
-      ++count;
-    }
+  const std::vector<int> selected = anchored_nodes(nodes, description);
+  for (const int i : selected) {
+    // disableCollisionBetweenLinkedBodies = false: that flag would switch off the contact of
+    // EVERY node with the bed (btSoftBody::m_collisionDisabledObjects is per body), and the
+    // free nodes must still land on it. Influence 1: the full anchor impulse (the anchor's
+    // stiffness is Bullet's kAHR, default 0.7 of the offset per solver pass).
+    body.appendAnchor(i, &bed, false, 1);
   }
-  return count;
+  return static_cast<int>(selected.size());
 }
 
 }  // namespace fissure::host

@@ -151,7 +151,6 @@ void SoftWorld::make_tool_parts(const SceneDescription& scene) {
     body.getMotionState()->setWorldTransform(bt(start[static_cast<std::size_t>(p)]));
     body.setInterpolationWorldTransform(bt(start[static_cast<std::size_t>(p)]));
   }
-
 }
 
 // FEM bodies step in Bullet's deformable world (fem_world.hpp): its own solver, not the classic
@@ -193,14 +192,7 @@ void SoftWorld::build_fem_world(const SceneDescription& scene) {
     const VolumeMesh mesh{file.vertices_world_m, file.tetrahedra, file.triangles};
     const int b = fem_->add_body(mesh, description.fem, FemContact{description.collision_margin_m, description.friction_ratio});
     stable_step_s = std::min(stable_step_s, fem_stable_step_s(mesh, description.fem));
-    std::vector<int> fixed;
-    for (std::size_t a = 0; a < description.anchors.size(); ++a) {
-      const std::vector<int> selected = nodes_in_anchor_box(file.vertices_world_m, description.anchors[a]);
-      if (selected.empty()) throw std::invalid_argument("soft_body.anchor[" + std::to_string(a) + "] selects no soft node");
-      fixed.insert(fixed.end(), selected.begin(), selected.end());
-    }
-    std::sort(fixed.begin(), fixed.end());
-    fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
+    const std::vector<int> fixed = anchored_nodes(file.vertices_world_m, description);
     fem_->fix_nodes(b, fixed);
     anchored_nodes_count_ += static_cast<int>(fixed.size());
     bodies_.push_back(&fem_->body(b));
@@ -212,7 +204,7 @@ void SoftWorld::build_fem_world(const SceneDescription& scene) {
   if (fem_substeps_ > kFemMaxSubsteps) {
     throw std::invalid_argument("[soft_body] model = \"fem\": a " + std::to_string(host_step_s * 1e3) + " ms step needs " + std::to_string(fem_substeps_) +
                                 " substeps for this mesh and material (the stable step is " + std::to_string(stable_step_s * 1e6) +
-                                " us: 0.3 x the shortest edge / the P-wave speed); at most " + std::to_string(kFemMaxSubsteps) +
+                                " us: 0.3 sqrt 2 x the thinnest tetrahedron's height / the P-wave speed); at most " + std::to_string(kFemMaxSubsteps) +
                                 " are run — use a coarser mesh, a softer material or a shorter time_step_s");
   }
   make_tool_parts(scene);

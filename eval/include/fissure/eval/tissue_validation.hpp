@@ -124,7 +124,7 @@ struct StepCostOptions {
   /// the symplectic one (explicit elasticity: unstable once the step exceeds ~h_min / c_p).
   bool implicit = false;
   /// Bullet steps per host step; 0: as many as the symplectic step's stability needs
-  /// (tissue_detail.hpp stable_step_s, Courant 0.3 of h_min / c_p), 1 for the implicit step.
+  /// (host::fem_stable_step_s: Courant 0.3·√2 of the thinnest tetrahedron / c_p), 1 for the implicit step.
   int substeps = 0;
   /// CG cap per Bullet step (FemWorldConfig): measured, the CG runs to its cap whatever its
   /// tolerance, and with mass damping only the system is diagonal (one iteration is exact).

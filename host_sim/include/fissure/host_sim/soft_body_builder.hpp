@@ -117,6 +117,11 @@ struct SoftBodyRest {
 /// Indices of the nodes (of `nodes_world_m`) inside `box`, bounds included, ascending.
 [[nodiscard]] std::vector<int> nodes_in_anchor_box(const std::vector<Vec3>& nodes_world_m, const SoftAnchorBox& box);
 
+/// The nodes (of `nodes_world_m`) the description's anchor boxes select, ascending, each once
+/// (boxes may overlap). Throws std::invalid_argument naming the box when a box selects no node
+/// (a scene built in code; the loader reports it with file and line).
+[[nodiscard]] std::vector<int> anchored_nodes(const std::vector<Vec3>& nodes_world_m, const SoftBodyDescription& description);
+
 /// Anchors the body's nodes selected by the description's anchor boxes (by their current
 /// positions: call right after build_soft_body, while the body is at rest) to `bed`, with
 /// Bullet's own anchors: the node keeps its mass and a rigid-contact-free link to the bed
