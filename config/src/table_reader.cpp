@@ -80,7 +80,7 @@ std::string unit_name(const std::string& suffix) {
       {"count", "a count"}, {"m_per_s", "metres per second"}, {"m_per_s2", "metres per second squared"},
       {"n_per_m", "newtons per metre"}, {"n_s_per_m", "newton-seconds per metre"},
       {"pa_per_m_pow_n", "Pa per metreⁿ (per unit area)"}, {"n_per_m_pow_n", "N per metreⁿ (per triangle)"},
-      {"pa_s_per_m_pow_n_plus_1", "Pa·s per metreⁿ⁺¹ (per unit area)"},
+      {"pa_s_per_m_pow_n_plus_1", "Pa·s per metreⁿ⁺¹ (per unit area)"}, {"pa_s_per_m", "Pa·s per metre (N·s/m³, per unit contact area)"},
       {"n_s_per_m_pow_n_plus_1", "N·s per metreⁿ⁺¹ (per triangle)"}, {"deg", "degrees"},
       {"kpr", "Bullet's kPR coefficient"}, {"kvc", "Bullet's kVC coefficient"}, {"pa", "pascals"},
       {"kg_per_m3", "kilograms per cubic metre"}, {"per_s", "per second"}};

@@ -123,6 +123,7 @@ HostSimulation::HostSimulation(const SceneDescription& scene, std::optional<Scen
     params.response = scene_.simulation.contact_response;
     params.friction_static_ratio = scene_.tool.friction_static_ratio;
     params.friction_kinetic_ratio = scene_.tool.friction_kinetic_ratio;
+    params.friction_shear_damping_pa_s_per_m = scene_.tool.friction_shear_damping_pa_s_per_m;
     NodeBoundsSolver* solver = world_->node_bounds_solver();
     if (params.response == ContactResponse::kInSolver && solver == nullptr)
       throw std::invalid_argument("contact_response = \"in_solver\" needs the instrumented soft-body solver (HostSimulationOptions::solver_node_bounds)");

@@ -338,6 +338,13 @@ void read_tool(const std::string& file, TableReader& t, ToolDescription& tool, c
   if (tool.friction_kinetic_ratio > tool.friction_static_ratio)
     t.fail(t.line_for("friction_kinetic", "ratio"), "friction_kinetic_ratio",
            "must be <= friction_static_ratio (" + config::format_number(tool.friction_static_ratio) + ")");
+  // A wet tool–tissue film's viscous shear: 0 (dry) up to a 1 Pa·s mucus-like film 1 µm thick.
+  const bool damping_given = t.find("friction_shear_damping", "pa_s_per_m") != nullptr;
+  tool.friction_shear_damping_pa_s_per_m =
+      t.in_range("friction_shear_damping", "pa_s_per_m", 0.0, kMaxFilmShearDamping_pa_s_per_m, kTissueFilmShearDamping_pa_s_per_m);
+  if (damping_given && tool.friction_shear_damping_pa_s_per_m > 0.0 && !(tool.friction_static_ratio > 0.0))
+    t.fail(t.line_for("friction_shear_damping", "pa_s_per_m"), "friction_shear_damping_pa_s_per_m",
+           "acts on sliding contacts only, so it needs friction (set friction_static_ratio > 0, or remove this key)");
   t.finish();
 }
 

@@ -146,6 +146,8 @@ void bind_scene(py::module_& m) {
                              "tool–tissue Coulomb friction, static (0: frictionless; needs contact_response 'in_solver')")
       .def_property_readonly("friction_kinetic_ratio", [](const SceneDescription& s) { return s.tool.friction_kinetic_ratio; },
                              "tool–tissue Coulomb friction, kinetic (≤ the static ratio)")
+      .def_property_readonly("friction_shear_damping_pa_s_per_m", [](const SceneDescription& s) { return s.tool.friction_shear_damping_pa_s_per_m; },
+                             "viscous shear of the wet tool–tissue contact per unit contact area [Pa·s/m], acting on sliding contacts")
       .def_property_readonly("soft_model",
                              [](const SceneDescription& s) { return std::string(s.soft_bodies.front().model == host::SoftBodyModel::kFem ? "fem" : "shell"); },
                              "'shell' (Bullet's mass-spring soft body) or 'fem' (Bullet's deformable-world FEM, SI material)")

@@ -193,6 +193,17 @@ TEST(SceneLoader, ToolFrictionIsOptionalCheckedAndNeedsTheInSolverResponse) {
   expect_error(load_error(kinetic_above), line_of(kinetic_above, "friction_kinetic_ratio"), "tool.friction_kinetic_ratio", "must be <= friction_static_ratio (0.2)");
   const std::string after_step = replace(good, "node_spacing_m = 0.003", "node_spacing_m = 0.003\nfriction_static_ratio = 0.5");
   expect_error(load_error(after_step), line_of(after_step, "friction_static_ratio"), "tool.friction_static_ratio", "contact_response = \"in_solver\"");
+  // The contact's viscous shear: the film default, a value of the user's, its range, and no
+  // damping without friction.
+  EXPECT_EQ(gripping.tool.friction_shear_damping_pa_s_per_m, kTissueFilmShearDamping_pa_s_per_m);
+  const std::string damped = replace(both, "friction_kinetic_ratio = 0.4", "friction_kinetic_ratio = 0.4\nfriction_shear_damping_pa_s_per_m = 2500");
+  EXPECT_EQ(load_scene_text(damped, "damped.toml", kScenes).tool.friction_shear_damping_pa_s_per_m, 2500.0);
+  const std::string absurd = replace(both, "friction_kinetic_ratio = 0.4", "friction_kinetic_ratio = 0.4\nfriction_shear_damping_pa_s_per_m = -1");
+  expect_error(load_error(absurd), line_of(absurd, "friction_shear_damping"), "tool.friction_shear_damping_pa_s_per_m", "must be in [0, 1e+06] (got -1)");
+  const std::string dry_damped = replace(in_solver, "node_spacing_m = 0.003", "node_spacing_m = 0.003\nfriction_shear_damping_pa_s_per_m = 1000");
+  expect_error(load_error(dry_damped), line_of(dry_damped, "friction_shear_damping"), "tool.friction_shear_damping_pa_s_per_m", "needs friction");
+  const std::string wrong_unit = replace(both, "friction_kinetic_ratio = 0.4", "friction_kinetic_ratio = 0.4\nfriction_shear_damping_n_s_per_m = 1");
+  expect_error(load_error(wrong_unit), line_of(wrong_unit, "friction_shear_damping_n"), "tool.friction_shear_damping_n_s_per_m", "wrong unit");
 }
 
 TEST(SceneLoader, ShapeMatchingIsOptionalAndRangeChecked) {

@@ -2,7 +2,8 @@
 // that presses into the slab, pulled along the face by a given move within one step. Inside the
 // cone (static × its Hunt-Crossley normal force F_n × h²/m) the move is undone whole; beyond it,
 // undone by kinetic × F_n·h²/m only, however many projection passes run; the force on the tool is
-// m·correction/h² — exactly kinetic × F_n while sliding. And the swept guard after the solve: a
+// m·correction/h² — exactly kinetic × F_n while sliding (plus the contact's viscous shear when it
+// has one). And the swept guard after the solve: a
 // node whose step path passes through the plate ends on the face that path enters by.
 #include "../../host_sim/src/thin_body/collision_state.hpp"
 #include "soft_scene_fixture.hpp"
@@ -141,6 +142,40 @@ TEST(SolverFriction, PullsSpreadOverIterationsShareOneCone) {
   const CollisionStepResult r = f.result();
   EXPECT_EQ(r.sliding_nodes, 1);
   EXPECT_NEAR(r.friction_force_on_tool_world_n.norm(), kKinetic * f.normal_force_n(), 1e-3 * kKinetic * f.normal_force_n());
+}
+
+// The contact's viscous shear (friction_shear_damping_pa_s_per_m): a sliding node's slip beyond the
+// kinetic cone is undone by the implicit share β/(1+β), β = b·A·h/m; sticking is unchanged, the
+// passes still share one correction, and the tool feels the whole correction.
+TEST(SolverFriction, ShearDampingUndoesItsImplicitShareOfTheSlipBeyondTheKineticCone) {
+  for (const double damping_pa_s_per_m : {1.0e3, 1.0e5, 1.0e9}) {
+    for (const int passes : {1, 4}) {
+      FrictionFixture f;
+      f.model.params.friction_shear_damping_pa_s_per_m = damping_pa_s_per_m;
+      const double cone = f.cone_m();
+      const double im = f.world.soft().m_nodes[f.node].m_im;
+      const double beta = damping_pa_s_per_m * f.model.soft.node_rest_area_m2[static_cast<std::size_t>(f.node)] * kStep_s * im;
+      const double pull = 3.0 * kStatic * cone;
+      const double undone = kKinetic * cone + beta / (1.0 + beta) * (pull - kKinetic * cone);
+      const Eigen::Vector3d anchor = f.node_tool();
+      f.pull_and_project(pull, passes);
+      const double kept = (f.node_tool() - anchor).x();
+      EXPECT_NEAR(kept, pull - undone, 1e-4 * pull) << damping_pa_s_per_m << " Pa·s/m, " << passes << " passes";
+      // It slows the slip, never reverses it.
+      EXPECT_GE(kept, -1e-9);
+      const CollisionStepResult r = f.result();
+      EXPECT_EQ(r.sliding_nodes, 1);
+      EXPECT_NEAR(r.friction_force_on_tool_world_n.norm(), undone / (im * kStep_s * kStep_s), 1e-3 * undone / (im * kStep_s * kStep_s));
+      EXPECT_GT(r.friction_force_on_tool_world_n.norm(), kKinetic * f.normal_force_n());
+    }
+  }
+  // Inside the static cone the node sticks whatever the damping.
+  FrictionFixture f;
+  f.model.params.friction_shear_damping_pa_s_per_m = 1.0e5;
+  const Eigen::Vector3d anchor = f.node_tool();
+  f.pull_and_project(0.5 * kStatic * f.cone_m(), 1);
+  EXPECT_NEAR((f.node_tool() - anchor).x(), 0.0, 1e-9);
+  EXPECT_EQ(f.result().sticking_nodes, 1);
 }
 
 TEST(SolverFriction, NoIndentationNoFriction) {

@@ -230,6 +230,7 @@ def test_help_documents_the_surface():
 def test_contact_response_and_tool_friction_reach_python():
     lift = fissure.Scene.load("clamp-vessel-lift", check_plausible=False)
     assert (lift.contact_response, lift.friction_static_ratio, lift.friction_kinetic_ratio) == ("in_solver", 0.5, 0.4)
+    assert lift.friction_shear_damping_pa_s_per_m == 1000.0
     assert lift.soft_model == "shell"
     sim = fissure.HostSimulation(lift)
     assert sim.contact_response == "in_solver"

@@ -23,7 +23,9 @@
 //    while undoing it costs at most static × F_n·h²/m — F_n the node's Hunt-Crossley normal force,
 //    so F_n·h is the normal impulse the tool gives it in the step — else undone by kinetic ×
 //    F_n·h²/m only (Coulomb at position level, Macklin et al. 2014): a node on the tool moves with
-//    the tool until the tangential pull exceeds the cone. The correction accumulates over the
+//    the tool until the tangential pull exceeds the cone. A sliding node's slip beyond the kinetic
+//    cone also meets the contact's viscous shear (friction_shear_damping_pa_s_per_m × its rest
+//    area), implicit: the share β/(1+β) of that excess is undone, β = b·h/m. The correction accumulates over the
 //    iterations (as XPBD accumulates a multiplier), so several iterations never spend the cone
 //    twice, and m·correction/h² is the friction force the node puts on the tool.
 // The rim constraint (rim_projection.cpp) runs before this in each pass, so this projection,
@@ -112,6 +114,7 @@ int project_contacts(const CollisionModel& model, const StepFrame& frame, btSoft
   const double skin_m = model.params.skin_m;
   const double mu_static = model.params.friction_static_ratio;
   const double mu_kinetic = model.params.friction_kinetic_ratio;
+  const double shear_damping = model.params.friction_shear_damping_pa_s_per_m;
   int projected = 0;
   for (const int node : data.broad.candidate_nodes) {
     btSoftBody::Node& soft_node = soft.m_nodes[node];
@@ -160,7 +163,11 @@ int project_contacts(const CollisionModel& model, const StepFrame& frame, btSoft
       if (free_slip_m <= mu_static * cone_m) {
         wanted = -free_slip;
       } else if (free_slip_m > 0.0) {
-        wanted = -free_slip * (mu_kinetic * cone_m / free_slip_m);
+        // Sliding: the kinetic cone, plus the implicit viscous share of the slip beyond it.
+        const double kinetic_m = mu_kinetic * cone_m;
+        const double beta = shear_damping * model.soft.node_rest_area_m2[n] * frame.dt_s * soft_node.m_im;  // b·h/m
+        const double undone_m = kinetic_m + (beta / (1.0 + beta)) * (free_slip_m - kinetic_m);
+        wanted = -free_slip * (undone_m / free_slip_m);
         data.solver.friction_sliding[n] = 1;
       }
       if (wanted != correction) {

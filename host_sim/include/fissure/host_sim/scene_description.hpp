@@ -146,6 +146,12 @@ struct ClampDescription {
   double jaw_gap_min_m = 0.0;                   ///< the jaws never close past this gap
 };
 
+/// Default viscous shear of a tool on wet tissue [Pa·s/m]: viscosity 1e-3 Pa·s over a 1e-6 m film
+/// (ToolDescription::friction_shear_damping_pa_s_per_m; docs/scenes.md).
+inline constexpr double kTissueFilmShearDamping_pa_s_per_m = 1.0e3;
+/// The loader's upper bound: a 1 Pa·s (mucus-like) film 1 µm thick.
+inline constexpr double kMaxFilmShearDamping_pa_s_per_m = 1.0e6;
+
 struct ToolDescription {
   ToolKind kind = ToolKind::kBox;
   Vec3 box_size_m{0.04, 0.004, 0.04};      ///< box tool: full extents (x width, y thickness, z length)
@@ -160,6 +166,12 @@ struct ToolDescription {
   /// else slides against kinetic × it. 0 / 0: frictionless (the paper's contact).
   double friction_static_ratio = 0.0;
   double friction_kinetic_ratio = 0.0;
+  /// With friction: viscous shear of the wet contact per unit contact area [Pa·s/m = N·s/m³],
+  /// acting on a sliding node's slip beyond the kinetic cone (ThinBodyCollisionParams). The
+  /// default is a Couette film estimate, viscosity / film thickness: a serous film of ~1 mPa·s
+  /// (water-like; water is 0.69 mPa·s at 37 °C) ~1 µm thick (docs/scenes.md). It adds
+  /// b·A·v, 0.1 mN per cm² of contact at 1 mm/s.
+  double friction_shear_damping_pa_s_per_m = kTissueFilmShearDamping_pa_s_per_m;
 };
 
 // What the Hunt-Crossley deformation x of a contacted triangle measures (docs/scenes.md,

@@ -67,6 +67,14 @@ struct ThinBodyCollisionParams {
   // Coulomb law of the rendered normal force. 0: frictionless.
   double friction_static_ratio = 0.0;
   double friction_kinetic_ratio = 0.0;
+  // In-solver, with friction: viscous shear of the contact per unit of contact area [Pa·s/m =
+  // N·s/m³] (SceneDescription's tool.friction_shear_damping_pa_s_per_m). A sliding node's slip
+  // beyond the kinetic cone meets b = this × its rest area, applied implicitly (the share
+  // β/(1+β) of that slip is undone, β = b·h/m), so it is stable at any value and never reverses
+  // the slip. Why: a discrete node on springs sliding under a slowly moving face sticks and slips
+  // step to step, and its average friction falls below μ_k·F_n (docs/decisions.md, "Friction and
+  // grasp"); a continuum with a lubricated contact slides steadily. 0: Coulomb only.
+  double friction_shear_damping_pa_s_per_m = 0.0;
 };
 
 // One contacted soft triangle (what the proxy builder needs: a plane per contact, which tool face
