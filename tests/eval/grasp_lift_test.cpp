@@ -31,6 +31,7 @@ TEST(GraspLift, TheShippedFrictionLiftsTheVesselWithTheJawsAndNoNodeSlidesDuring
   EXPECT_EQ(r.time_s.size(), r.jaw_gap_m.size());
   // The jaws let go: the force reaches 0 N and stays there once they clear the vessel.
   EXPECT_GE(r.release_delay_s, 0.0);
+  EXPECT_LE(r.release_delay_s, 5e-3) << "0 N within 5 ms of the jaws clearing the vessel (issue 23)";
   EXPECT_DOUBLE_EQ(r.jaw_a_normal_n.back() + r.jaw_b_normal_n.back() + r.jaw_a_friction_n.back() + r.jaw_b_friction_n.back(), 0.0);
 }
 
