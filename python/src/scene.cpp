@@ -51,6 +51,17 @@ const host::PlungeTool& plunge_tool_named(const std::string& name) {
   throw std::invalid_argument("no plunge tool '" + name + "' (tools: " + names + ")");
 }
 
+// The sweep's cell scene (bench_collision's): the plunge ball, optionally the 1280-face icosphere,
+// optionally the in-solver response with its bed anchor and the plunge's friction.
+SceneDescription plunge_cell_scene(const host::PlungeTool& tool, const std::string& contact_response, bool tool_friction, int icosphere_faces) {
+  const std::optional<host::ContactResponse> response = host::parse_contact_response(contact_response);
+  if (!response) throw std::invalid_argument("contact_response '" + contact_response + "' is not one of: after_step, in_solver");
+  if (icosphere_faces != 0 && icosphere_faces != 1280)
+    throw std::invalid_argument("icosphere_faces must be 0 (the paper's 128-face shell) or 1280 (the sweep's fine ball), got " + std::to_string(icosphere_faces));
+  const SceneDescription scene = host::plunge_scene(tool, icosphere_faces);
+  return *response == host::ContactResponse::kInSolver ? host::in_solver_plunge_scene(scene, tool_friction) : scene;
+}
+
 }  // namespace
 
 host::ToolPose tool_pose_from(const py::handle& pose, const host::ToolPose& orientation_from) {
@@ -207,13 +218,20 @@ void bind_scene(py::module_& m) {
       "The tunnelling sweep's tools (issue 5; host/plunge_hold.hpp): a list of dicts with name, kind,\n"
       "box_size_m (3,) [m], orientation_rpy_deg (3,), leading_half_m (tool origin to its lowest point) [m].");
   m.def(
-      "plunge_scene", [](const std::string& tool) { return host::plunge_scene(plunge_tool_named(tool)); }, py::arg("tool"),
-      "spatula-sphere with the named plunge tool and the plunge ball's pose matching (the sweep's scene).");
+      "plunge_scene",
+      [](const std::string& tool, const std::string& contact_response, bool tool_friction, int icosphere_faces) {
+        return plunge_cell_scene(plunge_tool_named(tool), contact_response, tool_friction, icosphere_faces);
+      },
+      py::arg("tool"), py::arg("contact_response") = "after_step", py::arg("tool_friction") = true, py::arg("icosphere_faces") = 0,
+      "spatula-sphere with the named plunge tool and the plunge ball's pose matching (the sweep's scene); contact_response\n"
+      "'in_solver' gives the bench's in-solver cell (the ball's bed anchored; tool_friction: the plunge's Coulomb friction\n"
+      "with the default viscous shear); icosphere_faces 1280: the sweep's fine ball.");
   m.def(
       "run_plunge_hold",
-      [](const std::string& tool_name, const std::string& method, double speed_m_s, double hold_s, bool count_cut_triangles) {
+      [](const std::string& tool_name, const std::string& method, double speed_m_s, double hold_s, bool count_cut_triangles,
+         const std::string& contact_response, bool tool_friction, int icosphere_faces) {
         const host::PlungeTool& tool = plunge_tool_named(tool_name);
-        const SceneDescription scene = host::plunge_scene(tool);
+        const SceneDescription scene = plunge_cell_scene(tool, contact_response, tool_friction, icosphere_faces);
         const host::SceneCollisionMethod parsed = parse_method(method);
         host::PlungeHoldResult r;
         {
@@ -244,12 +262,15 @@ void bind_scene(py::module_& m) {
         return d;
       },
       py::arg("tool"), py::arg("method"), py::arg("speed_m_s"), py::arg("hold_s") = 0.5, py::arg("count_cut_triangles") = false,
+      py::arg("contact_response") = "after_step", py::arg("tool_friction") = true, py::arg("icosphere_faces") = 0,
       "One cell of the tunnelling sweep (the function `fissure bench collision` runs): settle the plunge ball,\n"
       "drive `tool` (a plunge_tools() name) 20 mm into it at speed_m_s [m/s] with `method` ('paired', 'ray',\n"
       "'bullet'), hold hold_s [s] after a 50 ms settling window. Lockstep: every figure but step_s is deterministic.\n"
       "Returns crossed/wrong-side/inside nodes (worst step), max_penetration_m [m], hold_force_n (|F| per hold\n"
       "step, (H,) [N]), step_s (wall time per step, (S,) [s]), the hold statistics (fractions of the mean force)\n"
-      "and, with count_cut_triangles, the soft triangles cut by the tool during the hold (-1 otherwise).");
+      "and, with count_cut_triangles, the soft triangles cut by the tool during the hold (-1 otherwise).\n"
+      "contact_response 'in_solver' runs the bench's in-solver cell (the ball's bed anchored; tool_friction: the\n"
+      "plunge's Coulomb friction with the default viscous shear); icosphere_faces 1280: the sweep's fine ball.");
 }
 
 }  // namespace fissure::python

@@ -298,3 +298,19 @@ def test_several_soft_bodies_are_laid_out_body_after_body_and_contacts_name_thei
         if seen == {0, 1}:
             break
     assert seen == {0, 1}, "the blade in the cleft touches both lobes"
+
+
+def test_plunge_cells_in_either_response_and_on_either_ball():
+    after = fissure.plunge_scene("plate_4mm")
+    assert after.contact_response == "after_step"
+    in_solver = fissure.plunge_scene("plate_4mm", contact_response="in_solver")
+    assert in_solver.contact_response == "in_solver" and in_solver.friction_static_ratio > 0.0
+    assert fissure.plunge_scene("plate_4mm", contact_response="in_solver", tool_friction=False).friction_static_ratio == 0.0
+    assert fissure.HostSimulation(fissure.plunge_scene("plate_4mm", icosphere_faces=1280)).soft_face_count == 1280
+    with pytest.raises(ValueError, match="contact_response 'inside'"):
+        fissure.plunge_scene("plate_4mm", contact_response="inside")
+    with pytest.raises(ValueError, match="icosphere_faces must be 0"):
+        fissure.plunge_scene("plate_4mm", icosphere_faces=100)
+    cell = fissure.run_plunge_hold("plate_4mm", "paired", 1.0, hold_s=0.05, contact_response="in_solver")
+    assert cell["crossed_nodes"] == 0 and cell["inside_nodes"] == 0
+    assert cell["hold_force_n"].shape == (50,) and cell["hold"]["mean_n"] > 0.0
