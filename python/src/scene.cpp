@@ -56,8 +56,11 @@ const host::PlungeTool& plunge_tool_named(const std::string& name) {
 SceneDescription plunge_cell_scene(const host::PlungeTool& tool, const std::string& contact_response, bool tool_friction, int icosphere_faces) {
   const std::optional<host::ContactResponse> response = host::parse_contact_response(contact_response);
   if (!response) throw std::invalid_argument("contact_response '" + contact_response + "' is not one of: after_step, in_solver");
-  if (icosphere_faces != 0 && icosphere_faces != 1280)
-    throw std::invalid_argument("icosphere_faces must be 0 (the paper's 128-face shell) or 1280 (the sweep's fine ball), got " + std::to_string(icosphere_faces));
+  bool icosphere = false;
+  for (int faces = 20; faces <= 20480; faces *= 4) icosphere = icosphere || faces == icosphere_faces;
+  if (icosphere_faces != 0 && !icosphere)
+    throw std::invalid_argument("icosphere_faces must be 0 (the paper's 128-face shell) or an icosphere's 20·4^k faces (20 … 20480; the sweep's "
+                                "fine ball has 1280), got " + std::to_string(icosphere_faces));
   const SceneDescription scene = host::plunge_scene(tool, icosphere_faces);
   return *response == host::ContactResponse::kInSolver ? host::in_solver_plunge_scene(scene, tool_friction) : scene;
 }
@@ -225,7 +228,7 @@ void bind_scene(py::module_& m) {
       py::arg("tool"), py::arg("contact_response") = "after_step", py::arg("tool_friction") = true, py::arg("icosphere_faces") = 0,
       "spatula-sphere with the named plunge tool and the plunge ball's pose matching (the sweep's scene); contact_response\n"
       "'in_solver' gives the bench's in-solver cell (the ball's bed anchored; tool_friction: the plunge's Coulomb friction\n"
-      "with the default viscous shear); icosphere_faces 1280: the sweep's fine ball.");
+      "with the default viscous shear); icosphere_faces: an icosphere ball instead (1280: the sweep's fine ball).");
   m.def(
       "run_plunge_hold",
       [](const std::string& tool_name, const std::string& method, double speed_m_s, double hold_s, bool count_cut_triangles,
@@ -270,7 +273,7 @@ void bind_scene(py::module_& m) {
       "step, (H,) [N]), step_s (wall time per step, (S,) [s]), the hold statistics (fractions of the mean force)\n"
       "and, with count_cut_triangles, the soft triangles cut by the tool during the hold (-1 otherwise).\n"
       "contact_response 'in_solver' runs the bench's in-solver cell (the ball's bed anchored; tool_friction: the\n"
-      "plunge's Coulomb friction with the default viscous shear); icosphere_faces 1280: the sweep's fine ball.");
+      "plunge's Coulomb friction with the default viscous shear); icosphere_faces: an icosphere ball instead (1280: the sweep's fine ball).");
 }
 
 }  // namespace fissure::python

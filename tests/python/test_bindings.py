@@ -311,6 +311,7 @@ def test_plunge_cells_in_either_response_and_on_either_ball():
         fissure.plunge_scene("plate_4mm", contact_response="inside")
     with pytest.raises(ValueError, match="icosphere_faces must be 0"):
         fissure.plunge_scene("plate_4mm", icosphere_faces=100)
+    assert fissure.HostSimulation(fissure.plunge_scene("plate_4mm", icosphere_faces=320)).soft_face_count == 320
     cell = fissure.run_plunge_hold("plate_4mm", "paired", 1.0, hold_s=0.05, contact_response="in_solver")
     assert cell["crossed_nodes"] == 0 and cell["inside_nodes"] == 0
     assert cell["hold_force_n"].shape == (50,) and cell["hold"]["mean_n"] > 0.0

@@ -25,9 +25,10 @@
 //    F_n·h²/m only (Coulomb at position level, Macklin et al. 2014): a node on the tool moves with
 //    the tool until the tangential pull exceeds the cone. A sliding node's slip beyond the kinetic
 //    cone also meets the contact's viscous shear (friction_shear_damping_pa_s_per_m × its rest
-//    area), implicit: the share β/(1+β) of that excess is undone, β = b·h/m. The correction accumulates over the
-//    iterations (as XPBD accumulates a multiplier), so several iterations never spend the cone
-//    twice, and m·correction/h² is the friction force the node puts on the tool.
+//    area), implicit: the share β/(1+β) of that excess is undone, β = b·h/m. The correction
+//    accumulates over the iterations (as XPBD accumulates a multiplier), so several iterations
+//    never spend the cone twice, and m·correction/h² is the friction force the node puts on the
+//    tool.
 // The rim constraint (rim_projection.cpp) runs before this in each pass, so this projection,
 // which keeps nodes out of the tool, always has the last word.
 // guard_swept_paths, after the solve's velocity update: a node whose straight path over the step
