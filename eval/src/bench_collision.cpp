@@ -71,13 +71,6 @@ SceneDescription with_response(SceneDescription scene, host::ContactResponse res
   return scene;
 }
 
-// A plunge cell's scene: in_solver runs the tests' in-solver cells (tool friction unless
-// switched off, ball on its bed: host::in_solver_plunge_scene).
-SceneDescription plunge_cell_scene(const host::PlungeTool& tool, int icosphere_faces, host::ContactResponse response, bool tool_friction) {
-  const SceneDescription scene = host::plunge_scene(tool, icosphere_faces);
-  return response == host::ContactResponse::kInSolver ? host::in_solver_plunge_scene(scene, tool_friction) : with_response(scene, response);
-}
-
 // Least-squares slope of log F against log d (points with F > 0).
 double fitted_exponent(const std::vector<std::pair<double, double>>& curve) {
   double sx = 0, sy = 0, sxx = 0, sxy = 0;
@@ -164,7 +157,7 @@ nlohmann::json sweep_cells(const std::vector<double>& speeds, const std::vector<
   SimProgress progress(progress_name, static_cast<long>(speeds.size() * tools.size() * methods.size()));
   long done = 0;
   for (const host::PlungeTool& tool : tools) {
-    const SceneDescription scene = plunge_cell_scene(tool, icosphere_faces, response, tool_friction);
+    const SceneDescription scene = host::plunge_cell_scene(tool, icosphere_faces, response, tool_friction);
     const std::string tool_name(tool.name);
     for (SceneCollisionMethod method : methods) {
       for (double v : speeds) {
@@ -227,7 +220,7 @@ void run_motion_cells(const BenchCollisionOptions& o, nlohmann::json& out) {
               "F_hold N", "jitter%", "step%");
   nlohmann::json lever = nlohmann::json::array();
   for (const int faces : {0, kFineSweepFaces}) {
-    const SceneDescription scene = plunge_cell_scene(host::plunge_tools()[2], faces, o.contact_response, o.in_solver_tool_friction);
+    const SceneDescription scene = host::plunge_cell_scene(host::plunge_tools()[2], faces, o.contact_response, o.in_solver_tool_friction);
     for (SceneCollisionMethod method : {SceneCollisionMethod::kBullet, SceneCollisionMethod::kPaired}) {
       const host::LeverResult r = host::run_lever_hold(scene, method, hold_s);
       const int mesh = faces == 0 ? 128 : faces;

@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 #include <variant>
 
 #include "fissure/host_sim/host_simulation.hpp"
 #include "fissure/host_sim/scene_loader.hpp"
+#include "fissure/host_sim/soft_body_builder.hpp"
 
 namespace fissure::host {
 
@@ -20,6 +23,9 @@ const std::array<PlungeTool, 4>& plunge_tools() {
 }
 
 SceneDescription plunge_scene(const PlungeTool& tool, int icosphere_faces) {
+  if (icosphere_faces != 0 && !is_icosphere_face_count(icosphere_faces))
+    throw std::invalid_argument("icosphere_faces must be 0 (the paper's 128-face shell) or an icosphere's 20·4^k faces (20 … 20480; the "
+                                "sweep's fine ball has 1280), got " + std::to_string(icosphere_faces));
   SceneDescription s = load_scene(resolve_scene_path("spatula-sphere"));
   if (tool.kind == ToolKind::kConvexMesh) {
     s.tool = load_scene(resolve_scene_path("convex-spatula-sphere")).tool;
@@ -36,6 +42,13 @@ SceneDescription plunge_scene(const PlungeTool& tool, int icosphere_faces) {
     s.soft_bodies.front().shape = sphere;
   }
   return s;
+}
+
+SceneDescription plunge_cell_scene(const PlungeTool& tool, int icosphere_faces, ContactResponse response, bool tool_friction) {
+  SceneDescription scene = plunge_scene(tool, icosphere_faces);
+  if (response == ContactResponse::kInSolver) return in_solver_plunge_scene(scene, tool_friction);
+  scene.simulation.contact_response = response;
+  return scene;
 }
 
 SceneDescription in_solver_plunge_scene(SceneDescription scene, bool tool_friction) {

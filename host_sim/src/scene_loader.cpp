@@ -187,9 +187,7 @@ void read_soft_body(const std::string& file, TableReader& t, SoftBodyDescription
       t.fail(t.line_for("faces", "count"), "faces_count", "a bullet_ellipsoid has an even face count (2·res + 2)");
     }
     if (s.tessellation == SphereTessellation::kIcosphere) {
-      bool ok = false;
-      for (int f = 20; f <= 400000; f *= 4) ok = ok || f == s.faces_count;
-      if (!ok) t.fail(t.line_for("faces", "count"), "faces_count", "an icosphere has 20·4^k faces (20, 80, 320, 1280, 5120, 20480, …)");
+      if (!is_icosphere_face_count(s.faces_count)) t.fail(t.line_for("faces", "count"), "faces_count", "an icosphere has 20·4^k faces (20, 80, 320, 1280, 5120, 20480, …)");
     }
     soft.shape = s;
   } else if (shape == "cylinder") {

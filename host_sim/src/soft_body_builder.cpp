@@ -112,6 +112,12 @@ btSoftBody* create_from_tet_mesh(btSoftBodyWorldInfo& world_info, const VolumeMe
   return body;
 }
 
+bool is_icosphere_face_count(int faces) noexcept {
+  for (long f = 20; f <= faces; f *= 4)
+    if (f == faces) return true;
+  return false;
+}
+
 SurfaceMesh make_icosphere(const Vec3& center_m, double radius_m, int subdivisions) {
   const double phi = (1.0 + std::sqrt(5.0)) / 2.0;
   std::vector<Eigen::Vector3d> v = {{-1, phi, 0}, {1, phi, 0}, {-1, -phi, 0}, {1, -phi, 0}, {0, -1, phi}, {0, 1, phi},

@@ -51,18 +51,11 @@ const host::PlungeTool& plunge_tool_named(const std::string& name) {
   throw std::invalid_argument("no plunge tool '" + name + "' (tools: " + names + ")");
 }
 
-// The sweep's cell scene (bench_collision's): the plunge ball, optionally the 1280-face icosphere,
-// optionally the in-solver response with its bed anchor and the plunge's friction.
+// The sweep's cell scene (host::plunge_cell_scene) for a response named as in scene files.
 SceneDescription plunge_cell_scene(const host::PlungeTool& tool, const std::string& contact_response, bool tool_friction, int icosphere_faces) {
   const std::optional<host::ContactResponse> response = host::parse_contact_response(contact_response);
   if (!response) throw std::invalid_argument("contact_response '" + contact_response + "' is not one of: after_step, in_solver");
-  bool icosphere = false;
-  for (int faces = 20; faces <= 20480; faces *= 4) icosphere = icosphere || faces == icosphere_faces;
-  if (icosphere_faces != 0 && !icosphere)
-    throw std::invalid_argument("icosphere_faces must be 0 (the paper's 128-face shell) or an icosphere's 20·4^k faces (20 … 20480; the sweep's "
-                                "fine ball has 1280), got " + std::to_string(icosphere_faces));
-  const SceneDescription scene = host::plunge_scene(tool, icosphere_faces);
-  return *response == host::ContactResponse::kInSolver ? host::in_solver_plunge_scene(scene, tool_friction) : scene;
+  return host::plunge_cell_scene(tool, icosphere_faces, *response, tool_friction);
 }
 
 }  // namespace

@@ -52,7 +52,8 @@ struct PlungeTool {
 
 /// spatula-sphere with `tool` and the plunge ball's pose matching; with icosphere_faces > 0 the
 /// ball is an icosphere of that many faces (issue 22's second mesh: 1280) instead of the
-/// paper's 128-face shell. Loads shipped scenes (throws SceneError when they cannot be found).
+/// paper's 128-face shell. Loads shipped scenes (throws SceneError when they cannot be found;
+/// std::invalid_argument for a face count no icosphere has).
 [[nodiscard]] SceneDescription plunge_scene(const PlungeTool& tool, int icosphere_faces = 0);
 
 /// The in-solver cells (contact_response = "in_solver", issue 22): the contact is then as stiff as
@@ -73,6 +74,9 @@ inline constexpr double kPlungeBedTop_m = 0.015;
 /// `tool_friction` is false: the frictionless cells issue 23 also holds the contact to) and the
 /// ball on its bed.
 [[nodiscard]] SceneDescription in_solver_plunge_scene(SceneDescription scene, bool tool_friction = true);
+/// A sweep cell's scene (`fissure bench collision`, Python's plunge_scene): plunge_scene with
+/// `response`; in_solver through in_solver_plunge_scene (friction unless switched off, the bed).
+[[nodiscard]] SceneDescription plunge_cell_scene(const PlungeTool& tool, int icosphere_faces, ContactResponse response, bool tool_friction);
 
 /// Where a plunge starts: the tool kPlungeStartClearance_m above the settled soft surface, and
 /// the height of its origin once the leading face is kPlungeDepth_m below that surface [m, world y].

@@ -30,6 +30,8 @@ struct SurfaceMesh {
 
 /// Geodesic sphere: icosahedron subdivided `subdivisions` times (20·4^s faces).
 [[nodiscard]] SurfaceMesh make_icosphere(const Vec3& center_m, double radius_m, int subdivisions);
+/// Whether `faces` is an icosphere's face count, 20·4^k (20, 80, 320, 1280, …).
+[[nodiscard]] bool is_icosphere_face_count(int faces) noexcept;
 [[nodiscard]] SurfaceMesh make_cylinder(const SoftCylinder& cylinder);
 [[nodiscard]] SurfaceMesh make_slab(const SoftSlab& slab);
 /// The shipped organ-like lobe (scenes/meshes/organ-blob.obj, written by `fissure sim
