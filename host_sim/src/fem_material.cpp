@@ -5,6 +5,15 @@
 
 namespace fissure::host {
 
+const char* fem_model_name(FemModel model) noexcept {
+  switch (model) {
+    case FemModel::kCorotatedSmoothed: return "corotated_smoothed";
+    case FemModel::kCorotatedLinear: return "corotated_linear";
+    case FemModel::kNeoHookean: return "neo_hookean";
+  }
+  return "unknown";
+}
+
 LameParameters lame_parameters(const FemMaterial& m) noexcept {
   const double e = m.youngs_modulus_pa, nu = m.poisson_ratio;
   return {e / (2.0 * (1.0 + nu)), e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))};

@@ -22,6 +22,8 @@
 #include <BulletSoftBody/btSoftBody.h>
 #include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
 #include <btBulletDynamicsCommon.h>
+
+#include "fem_smoothed_strain_force.hpp"
 #pragma GCC diagnostic pop
 
 namespace fissure::host {
@@ -134,6 +136,9 @@ int FemWorld::add_body(const VolumeMesh& mesh, const FemMaterial& material, cons
   const auto mu = static_cast<btScalar>(lame.mu_pa), lambda = static_cast<btScalar>(lame.lambda_pa);
   if (material.model == FemModel::kNeoHookean) {
     forces_.push_back(std::make_unique<btDeformableNeoHookeanForce>(mu, lambda, static_cast<btScalar>(material.stiffness_damping_s)));
+  } else if (material.model == FemModel::kCorotatedSmoothed) {
+    forces_.push_back(std::make_unique<SmoothedStrainElasticityForce>(mu, lambda, static_cast<btScalar>(material.mass_damping_per_s),
+                                                                      static_cast<btScalar>(material.stiffness_damping_s)));
   } else {
     forces_.push_back(std::make_unique<btDeformableLinearElasticityForce>(mu, lambda, static_cast<btScalar>(material.mass_damping_per_s),
                                                                          static_cast<btScalar>(material.stiffness_damping_s)));

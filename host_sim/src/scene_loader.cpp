@@ -159,8 +159,11 @@ void read_fem_material(const std::string& file, TableReader& t, SoftBodyDescript
     t.fail(t.line_for("model", ""), "model", "\"fem\" needs a volumetric body: shape = \"mesh\" with a tetrahedral mesh_path (.msh, .vtk, .node)");
   }
   FemMaterial& m = soft.fem;
-  m.model = t.choice<FemModel>("elasticity", {{"corotated_linear", FemModel::kCorotatedLinear}, {"neo_hookean", FemModel::kNeoHookean}},
-                               FemModel::kCorotatedLinear);
+  m.model = t.choice<FemModel>("elasticity",
+                               {{fem_model_name(FemModel::kCorotatedSmoothed), FemModel::kCorotatedSmoothed},
+                                {fem_model_name(FemModel::kCorotatedLinear), FemModel::kCorotatedLinear},
+                                {fem_model_name(FemModel::kNeoHookean), FemModel::kNeoHookean}},
+                               FemModel::kCorotatedSmoothed);
   m.youngs_modulus_pa = t.in_range("youngs_modulus", "pa", kYoungsModulusMinPa, kYoungsModulusMaxPa);
   m.poisson_ratio = t.in_range("poisson", "ratio", kPoissonRatioMin, kPoissonRatioMax);
   m.density_kg_per_m3 = t.in_range("density", "kg_per_m3", kDensityMinKgPerM3, kDensityMaxKgPerM3);

@@ -1,7 +1,8 @@
 // eval/src/tissue_punch.cpp: the flat punch on the coarsest meshes a test can afford. Issue 24's
 // bound (slope within 15 % of Sneddon) is checked by `fissure bench tissue` at its finest mesh;
-// it is NOT met at these resolutions (docs/decisions.md, "Tissue (issue 24)": on this ±8 a
-// block +69 % at 1 cell per radius, +28 % at 2), so this test holds what is true of them: the
+// it is NOT met at 1 cell per radius (docs/decisions.md, "Tissue (issue 24)": on this ±8 a
+// block the default smoothed-strain model is +20.2 % at 1 cell per radius and +2.5 % at 2;
+// Bullet's one-strain element +69 % / +28 %), so this test holds what is true of them: the
 // force is linear in the depth, every mesh is stiffer than Sneddon (the discrete footprint and the finite block both
 // stiffen it), and refining moves the slope towards Sneddon.
 #include <cmath>

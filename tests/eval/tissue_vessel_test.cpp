@@ -1,8 +1,10 @@
 // eval/src/tissue_vessel.cpp: a vessel resting on the ground, on coarse meshes (`fissure bench
-// tissue` runs the finer ones). Linear tetrahedra lock in the wall's bending (docs/decisions.md,
-// "Tissue (issue 24)": −88 % of Roark's flattening with one cell through the 2 mm wall, −66 % with
-// two and 64 around), so this test holds what is true of them: the section flattens and spreads,
-// less than Roark's ring, more as the mesh is refined, and the anchor itself is Roark's.
+// tissue` runs the finer ones, where the default smoothed-strain model comes within Roark's
+// bound). One cell through the 2 mm wall is far too coarse for its bending (docs/decisions.md,
+// "Tissue (issue 24)": −79 % / −54 % of Roark's flattening at 16 / 32 cells around, Bullet's own
+// element −85 % at 32), so this test holds what is true of these meshes: the section flattens
+// and spreads, less than Roark's ring, more as the mesh is refined, and the anchor itself is
+// Roark's.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -28,7 +30,7 @@ TEST(TissueVessel, FlattensAndSpreadsBelowRoarksRingAndMoreWhenRefined) {
   for (const VesselResult* r : {&a, &b}) {
     EXPECT_LT(r->vertical_change_m, 0.0);    // flattened ...
     EXPECT_GT(r->horizontal_change_m, 0.0);  // ... and spread
-    EXPECT_GT(r->vertical_change_m, r->expected_vertical_change_m);  // stiffer than the ring: locking
+    EXPECT_GT(r->vertical_change_m, r->expected_vertical_change_m);  // stiffer than the ring at this coarseness
     EXPECT_LT(r->horizontal_change_m, r->expected_horizontal_change_m);
     EXPECT_GT(r->ovalisation, 0.0);
     EXPECT_LT(r->max_speed_m_per_s, 1e-6);

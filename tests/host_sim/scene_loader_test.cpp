@@ -467,7 +467,7 @@ TEST_F(FemSceneLoader, ReadsTheSiMaterialAndTheMassFromDensityAndVolume) {
   EXPECT_NEAR(scene.soft_bodies.front().mass_kg, 1040.0 * 0.02 * 0.01 * 0.02, 1e-12);
   // The defaults: a shell unless told otherwise, corotated linear elasticity.
   EXPECT_EQ(load_scene_text(shell_, "good.toml", kScenes).soft_bodies.front().model, SoftBodyModel::kShell);
-  EXPECT_EQ(load_scene_text(fem_scene(kLiver), "good.toml", kScenes).soft_bodies.front().fem.model, FemModel::kCorotatedLinear);
+  EXPECT_EQ(load_scene_text(fem_scene(kLiver), "good.toml", kScenes).soft_bodies.front().fem.model, FemModel::kCorotatedSmoothed);
 }
 
 TEST_F(FemSceneLoader, OutOfRangeMaterialNamesFileLineFieldValueAndRange) {

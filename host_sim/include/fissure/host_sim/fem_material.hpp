@@ -1,6 +1,7 @@
 #pragma once
 // A soft tissue's material in SI units (issue 24) and how it maps onto the parameters of Bullet's
-// deformable-world FEM forces (btDeformableLinearElasticityForce, btDeformableNeoHookeanForce).
+// deformable-world FEM forces (btDeformableLinearElasticityForce, btDeformableNeoHookeanForce) and
+// of the project's smoothed-strain force built on the first (fem_smoothed_strain_force.hpp).
 //
 // Bullet's conventions, read in its source (bullet3 3.24, BulletSoftBody/):
 // * both forces take Lamé parameters (mu, lambda) in Pa: the stress P they compute is multiplied
@@ -23,13 +24,21 @@
 namespace fissure::host {
 
 enum class FemModel : std::uint8_t {
-  kCorotatedLinear,  ///< btDeformableLinearElasticityForce (the validated default)
+  /// Corotated linear elasticity with smoothed strains (selective FS/NS-FEM: deviatoric strain
+  /// averaged over each face's two tetrahedra, volumetric over each node's): the default, because
+  /// plain linear tetrahedra lock in bending at tissue's ν (fissure bench tissue's cantilever at
+  /// 4 cells across: −40 % with Bullet's force, docs/decisions.md "Tissue (issue 24)").
+  kCorotatedSmoothed,
+  kCorotatedLinear,  ///< btDeformableLinearElasticityForce: one constant strain per tetrahedron
   kNeoHookean,       ///< btDeformableNeoHookeanForce, reparameterised as above
 };
 
+/// The scene file's name of a model ("corotated_smoothed", "corotated_linear", "neo_hookean").
+[[nodiscard]] const char* fem_model_name(FemModel model) noexcept;
+
 /// A volumetric soft body's material (const model: what the scene says).
 struct FemMaterial {
-  FemModel model = FemModel::kCorotatedLinear;
+  FemModel model = FemModel::kCorotatedSmoothed;
   double youngs_modulus_pa = 2000.0;       ///< brain ~1–3 kPa (kBrainYoungsModulusPa)
   double poisson_ratio = 0.45;             ///< nearly incompressible tissue (kTissuePoissonRatio)
   double density_kg_per_m3 = 1040.0;       ///< kTissueDensityKgPerM3
@@ -45,8 +54,8 @@ inline constexpr double kBrainYoungsModulusPa = 2000.0;
 /// fibrotic higher; elastography normal ≤ 7 kPa).
 inline constexpr double kLiverYoungsModulusPa = 7000.0;
 /// Soft tissue is nearly incompressible: ν 0.45–0.49 in the same references; 0.45 is the low
-/// end, because linear tetrahedra lock (are too stiff in bending) more as ν → 0.5
-/// (docs/decisions.md, "Tissue (issue 24)").
+/// end, because linear tetrahedra lock (are too stiff in bending) more as ν → 0.5 — much less
+/// with the smoothed strains of kCorotatedSmoothed (docs/decisions.md, "Tissue (issue 24)").
 inline constexpr double kTissuePoissonRatio = 0.45;
 /// Soft tissue density ~1040 kg/m³ (ICRP 23 / ICRU 44 soft tissue, brain 1040).
 inline constexpr double kTissueDensityKgPerM3 = 1040.0;
