@@ -25,11 +25,11 @@ double squared_norm(const btMatrix3x3& m) { return m[0].length2() + m[1].length2
 
 std::size_t local_index(const btSoftBody& body, const btSoftBody::Node* node) { return static_cast<std::size_t>(node - &body.m_nodes[0]); }
 
-void scatter(const btSoftBody::Tetra& tetra, const btMatrix3x3& force_on_node123, btScalar weight, btDeformableLagrangianForce::TVStack& out) {
-  out[tetra.m_n[0]->index] -= weight * (force_on_node123 * kFirstShapeGradient);
-  out[tetra.m_n[1]->index] -= weight * force_on_node123.getColumn(0);
-  out[tetra.m_n[2]->index] -= weight * force_on_node123.getColumn(1);
-  out[tetra.m_n[3]->index] -= weight * force_on_node123.getColumn(2);
+void scatter(const std::array<int, 4>& stack_index, const btMatrix3x3& force_on_node123, btScalar weight, btDeformableLagrangianForce::TVStack& out) {
+  out[stack_index[0]] -= weight * (force_on_node123 * kFirstShapeGradient);
+  out[stack_index[1]] -= weight * force_on_node123.getColumn(0);
+  out[stack_index[2]] -= weight * force_on_node123.getColumn(1);
+  out[stack_index[3]] -= weight * force_on_node123.getColumn(2);
 }
 
 // A face as its three sorted node indices packed in 21 bits each (bodies under 2M nodes).
@@ -79,6 +79,26 @@ SmoothedStrainElasticityForce::BodyScratch& SmoothedStrainElasticityForce::scrat
       open_faces.erase(it);
     }
   }
+  fresh.stack_index.assign(nodes, 0);
+  fresh.tetra_nodes.resize(tetras);
+  for (std::size_t j = 0; j < tetras; ++j) {
+    for (std::size_t k = 0; k < 4; ++k) fresh.tetra_nodes[j][k] = static_cast<int>(local_index(body, body.m_tetras[static_cast<int>(j)].m_n[k]));
+  }
+  fresh.own_weight.assign(tetras, 0.0);
+  fresh.neighbour_weight.assign(tetras, {0.0F, 0.0F, 0.0F, 0.0F});
+  for (std::size_t j = 0; j < tetras; ++j) {
+    const double own_volume = body.m_tetras[static_cast<int>(j)].m_element_measure;
+    for (std::size_t k = 0; k < 4; ++k) {
+      const int n = fresh.face_neighbours[j][k];
+      if (n < 0) {
+        fresh.own_weight[j] += 1.0;
+        continue;
+      }
+      const double other_volume = body.m_tetras[n].m_element_measure;
+      fresh.own_weight[j] += own_volume / (own_volume + other_volume);
+      fresh.neighbour_weight[j][k] = static_cast<float>(other_volume / (own_volume + other_volume));
+    }
+  }
   for (BodyScratch& s : scratch_) {
     if (s.body == &body) {
       s = std::move(fresh);
@@ -97,12 +117,18 @@ void SmoothedStrainElasticityForce::add_smoothed_stress_forces(btScalar scale, d
     if (!body->isActive()) continue;
     BodyScratch& s = scratch_for(*body);
     std::fill(s.node_volumetric_strain.begin(), s.node_volumetric_strain.end(), 0.0);
+    for (int a = 0; a < body->m_nodes.size(); ++a) s.stack_index[static_cast<std::size_t>(a)] = body->m_nodes[a].index;
+    const auto stack_indices = [&s](std::size_t t) {
+      const std::array<int, 4>& local = s.tetra_nodes[t];
+      return std::array<int, 4>{s.stack_index[static_cast<std::size_t>(local[0])], s.stack_index[static_cast<std::size_t>(local[1])],
+                                s.stack_index[static_cast<std::size_t>(local[2])], s.stack_index[static_cast<std::size_t>(local[3])]};
+    };
     for (int j = 0; j < body->m_tetras.size(); ++j) {
-      const btSoftBody::Tetra& tetra = body->m_tetras[j];
-      const btMatrix3x3 e = strain(*body, j);
-      s.element_strain[static_cast<std::size_t>(j)] = e;
-      const double quarter_volume_trace = 0.25 * tetra.m_element_measure * trace(e);
-      for (const btSoftBody::Node* node : tetra.m_n) s.node_volumetric_strain[local_index(*body, node)] += quarter_volume_trace;
+      const auto t = static_cast<std::size_t>(j);
+      const btMatrix3x3 e = strain(*body, j, stack_indices(t));
+      s.element_strain[t] = e;
+      const double quarter_volume_trace = 0.25 * body->m_tetras[j].m_element_measure * trace(e);
+      for (const int a : s.tetra_nodes[t]) s.node_volumetric_strain[static_cast<std::size_t>(a)] += quarter_volume_trace;
     }
     for (std::size_t a = 0; a < s.node_volumetric_strain.size(); ++a) {
       if (s.node_volume_m3[a] > 0.0) s.node_volumetric_strain[a] /= s.node_volume_m3[a];
@@ -110,21 +136,15 @@ void SmoothedStrainElasticityForce::add_smoothed_stress_forces(btScalar scale, d
     for (int j = 0; j < body->m_tetras.size(); ++j) {
       const btSoftBody::Tetra& tetra = body->m_tetras[j];
       const auto t = static_cast<std::size_t>(j);
-      const double own_volume = tetra.m_element_measure;
-      btMatrix3x3 face_mean = btMatrix3x3::getIdentity() * btScalar(0);
-      for (const int n : s.face_neighbours[t]) {
-        if (n < 0) {
-          face_mean += s.element_strain[t];
-          continue;
-        }
-        const double other_volume = body->m_tetras[n].m_element_measure;
-        face_mean += (s.element_strain[t] * btScalar(own_volume) + s.element_strain[static_cast<std::size_t>(n)] * btScalar(other_volume)) *
-                     btScalar(1.0 / (own_volume + other_volume));
+      btMatrix3x3 face_mean = s.element_strain[t] * btScalar(s.own_weight[t]);
+      for (std::size_t k = 0; k < 4; ++k) {
+        const int n = s.face_neighbours[t][k];
+        if (n >= 0) face_mean += s.element_strain[static_cast<std::size_t>(n)] * s.neighbour_weight[t][k];
       }
       double node_mean = 0.0;
-      for (const btSoftBody::Node* node : tetra.m_n) node_mean += 0.25 * s.node_volumetric_strain[local_index(*body, node)];
+      for (const int a : s.tetra_nodes[t]) node_mean += 0.25 * s.node_volumetric_strain[static_cast<std::size_t>(a)];
       const btMatrix3x3 stress = deviatoric_part(face_mean * btScalar(0.25)) * btScalar(2.0 * mu) + btMatrix3x3::getIdentity() * btScalar(bulk * node_mean);
-      scatter(tetra, rotation(*body, j) * stress * tetra.m_Dm_inverse.transpose(), scale * tetra.m_element_measure, out);
+      scatter(stack_indices(t), rotation(*body, j) * stress * tetra.m_Dm_inverse.transpose(), scale * tetra.m_element_measure, out);
     }
   }
 }
@@ -145,7 +165,7 @@ btMatrix3x3 damping_rotation(const btSoftBody& body, int j) {
 void SmoothedStrainElasticityForce::addScaledElasticForce(btScalar scale, TVStack& force) {
   add_smoothed_stress_forces(
       scale, m_mu, m_lambda,
-      [](const btSoftBody& body, int j) {
+      [](const btSoftBody& body, int j, const std::array<int, 4>&) {
         const btSoftBody::TetraScratch& t = body.m_tetraScratches[j];
         return symmetric_part(t.m_corotation.transpose() * t.m_F) - btMatrix3x3::getIdentity();
       },
@@ -155,9 +175,8 @@ void SmoothedStrainElasticityForce::addScaledElasticForce(btScalar scale, TVStac
 void SmoothedStrainElasticityForce::addScaledElasticForceDifferential(btScalar scale, const TVStack& dx, TVStack& df) {
   add_smoothed_stress_forces(
       scale, m_mu, m_lambda,
-      [&](const btSoftBody& body, int j) {
-        const btSoftBody::Tetra& tetra = body.m_tetras[j];
-        const btMatrix3x3 gradient = Ds(tetra.m_n[0]->index, tetra.m_n[1]->index, tetra.m_n[2]->index, tetra.m_n[3]->index, dx) * tetra.m_Dm_inverse;
+      [&](const btSoftBody& body, int j, const std::array<int, 4>& node) {
+        const btMatrix3x3 gradient = Ds(node[0], node[1], node[2], node[3], dx) * body.m_tetras[j].m_Dm_inverse;
         return symmetric_part(body.m_tetraScratches[j].m_corotation.transpose() * gradient);
       },
       element_rotation, df);
@@ -167,7 +186,7 @@ void SmoothedStrainElasticityForce::addScaledDampingForce(btScalar scale, TVStac
   if (m_damping_beta != 0) {
     add_smoothed_stress_forces(
         scale, m_damping_beta * m_mu, m_damping_beta * m_lambda,
-        [&](const btSoftBody& body, int j) {
+        [&](const btSoftBody& body, int j, const std::array<int, 4>&) {
           const btSoftBody::Tetra& tetra = body.m_tetras[j];
           const btMatrix3x3 gradient = DsFromVelocity(tetra.m_n[0], tetra.m_n[1], tetra.m_n[2], tetra.m_n[3]) * tetra.m_Dm_inverse;
           return symmetric_part(damping_rotation(body, j).transpose() * gradient);
@@ -189,9 +208,8 @@ void SmoothedStrainElasticityForce::addScaledDampingForceDifferential(btScalar s
   if (m_damping_beta != 0) {
     add_smoothed_stress_forces(
         scale, m_damping_beta * m_mu, m_damping_beta * m_lambda,
-        [&](const btSoftBody& body, int j) {
-          const btSoftBody::Tetra& tetra = body.m_tetras[j];
-          const btMatrix3x3 gradient = Ds(tetra.m_n[0]->index, tetra.m_n[1]->index, tetra.m_n[2]->index, tetra.m_n[3]->index, dv) * tetra.m_Dm_inverse;
+        [&](const btSoftBody& body, int j, const std::array<int, 4>& node) {
+          const btMatrix3x3 gradient = Ds(node[0], node[1], node[2], node[3], dv) * body.m_tetras[j].m_Dm_inverse;
           return symmetric_part(damping_rotation(body, j).transpose() * gradient);
         },
         damping_rotation, df);
