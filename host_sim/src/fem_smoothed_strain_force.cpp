@@ -160,6 +160,20 @@ btMatrix3x3 damping_rotation(const btSoftBody& body, int j) {
   return t.m_J < TETRA_FLAT_THRESHOLD ? btMatrix3x3::getIdentity() : t.m_corotation;
 }
 
+// Bullet's mass-proportional damping, −α·m·v per node (or its differential, with dv for v).
+template <class Velocity>
+void add_mass_damping(const btAlignedObjectArray<btSoftBody*>& bodies, btScalar scaled_alpha, Velocity velocity, btDeformableLagrangianForce::TVStack& out) {
+  if (scaled_alpha == 0) return;
+  for (int i = 0; i < bodies.size(); ++i) {
+    const btSoftBody* body = bodies[i];
+    if (!body->isActive()) continue;
+    for (int j = 0; j < body->m_nodes.size(); ++j) {
+      const btSoftBody::Node& node = body->m_nodes[j];
+      if (node.m_im > 0) out[node.index] -= scaled_alpha * velocity(node) / node.m_im;
+    }
+  }
+}
+
 }  // namespace
 
 void SmoothedStrainElasticityForce::addScaledElasticForce(btScalar scale, TVStack& force) {
@@ -193,15 +207,7 @@ void SmoothedStrainElasticityForce::addScaledDampingForce(btScalar scale, TVStac
         },
         damping_rotation, force);
   }
-  if (m_damping_alpha == 0) return;
-  for (int i = 0; i < m_softBodies.size(); ++i) {
-    btSoftBody* body = m_softBodies[i];
-    if (!body->isActive()) continue;
-    for (int j = 0; j < body->m_nodes.size(); ++j) {
-      const btSoftBody::Node& node = body->m_nodes[j];
-      if (node.m_im > 0) force[node.index] -= scale * node.m_v / node.m_im * m_damping_alpha;
-    }
-  }
+  add_mass_damping(m_softBodies, scale * m_damping_alpha, [](const btSoftBody::Node& node) { return node.m_v; }, force);
 }
 
 void SmoothedStrainElasticityForce::addScaledDampingForceDifferential(btScalar scale, const TVStack& dv, TVStack& df) {
@@ -214,15 +220,7 @@ void SmoothedStrainElasticityForce::addScaledDampingForceDifferential(btScalar s
         },
         damping_rotation, df);
   }
-  if (m_damping_alpha == 0) return;
-  for (int i = 0; i < m_softBodies.size(); ++i) {
-    btSoftBody* body = m_softBodies[i];
-    if (!body->isActive()) continue;
-    for (int j = 0; j < body->m_nodes.size(); ++j) {
-      const btSoftBody::Node& node = body->m_nodes[j];
-      if (node.m_im > 0) df[node.index] -= scale * dv[node.index] / node.m_im * m_damping_alpha;
-    }
-  }
+  add_mass_damping(m_softBodies, scale * m_damping_alpha, [&dv](const btSoftBody::Node& node) { return dv[node.index]; }, df);
 }
 
 double SmoothedStrainElasticityForce::totalElasticEnergy(btScalar) {
