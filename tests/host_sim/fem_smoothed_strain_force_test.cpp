@@ -1,7 +1,8 @@
-// host_sim/src/fem_smoothed_strain_force.cpp: the smoothed-strain corotated force — no force under
-// a rigid motion beyond Bullet's corotation residual, Bullet's force under a homogeneous strain, the force the gradient of its
-// energy and the differential the derivative of the force (finite differences), and a body that
-// bends where Bullet's per-element force locks.
+// host_sim/src/fem_smoothed_strain_force.cpp: the smoothed-strain corotated force — no force
+// under a rigid motion beyond Bullet's corotation residual; Bullet's force and damping under a
+// homogeneous strain and strain rate; the force the gradient of its energy and the differential
+// the derivative of the force (finite differences); a body that bends where Bullet's
+// per-element force locks.
 #include "fem_smoothed_strain_force.hpp"
 
 #include <cmath>
@@ -126,6 +127,42 @@ TEST_F(SmoothedStrainForceTest, AHomogeneousStrainGivesBulletsForce) {
   const TVStack ours = elastic_force(*smoothed_, nodes()), bullets = elastic_force(*bullet_, nodes());
   ASSERT_GT(largest(bullets), 1e-3);
   for (int i = 0; i < nodes(); ++i) EXPECT_LT((ours[i] - bullets[i]).length(), 1e-4 * largest(bullets)) << "node " << i;
+}
+
+// The damping (Bullet's: stiffness-proportional β on the strain rate, mass-proportional α) goes
+// through the same smoothed stress: under a homogeneous velocity gradient it is Bullet's, and so
+// is its differential along a homogeneous direction.
+TEST_F(SmoothedStrainForceTest, DampingIsBulletsUnderAHomogeneousVelocityGradient) {
+  const LameParameters lame = lame_parameters([] {
+    FemMaterial m;
+    m.youngs_modulus_pa = kYoungsPa;
+    m.poisson_ratio = kPoisson;
+    return m;
+  }());
+  const auto mu = static_cast<btScalar>(lame.mu_pa), lambda = static_cast<btScalar>(lame.lambda_pa);
+  SmoothedStrainElasticityForce smoothed(mu, lambda, 3.0F, 0.02F);
+  btDeformableLinearElasticityForce bullet(mu, lambda, 3.0F, 0.02F);
+  smoothed.addSoftBody(block_->soft.get());
+  bullet.addSoftBody(block_->soft.get());
+  const btMatrix3x3 rotation = rotation_about(btVector3(1, 1, 0), 0.3);
+  place(*block_->soft, transformed(block_->rest, rotation, btVector3(0, 0, 0)));
+  const btMatrix3x3 velocity_gradient(0.5, 0.1, 0.0, 0.1, -0.2, 0.05, 0.0, 0.05, 0.3);  // [1/s]
+  TVStack direction = zero_stack(nodes());
+  for (int i = 0; i < nodes(); ++i) {
+    block_->soft->m_nodes[i].m_v = velocity_gradient * block_->soft->m_nodes[i].m_x;
+    direction[i] = block_->soft->m_nodes[i].m_v;
+  }
+  TVStack ours = zero_stack(nodes()), bullets = zero_stack(nodes());
+  smoothed.addScaledDampingForce(1, ours);
+  bullet.addScaledDampingForce(1, bullets);
+  ASSERT_GT(largest(bullets), 0.0);
+  for (int i = 0; i < nodes(); ++i) EXPECT_LT((ours[i] - bullets[i]).length(), 1e-4 * largest(bullets)) << "node " << i;
+  TVStack our_differential = zero_stack(nodes()), bullets_differential = zero_stack(nodes());
+  smoothed.addScaledDampingForceDifferential(1, direction, our_differential);
+  bullet.addScaledDampingForceDifferential(1, direction, bullets_differential);
+  ASSERT_GT(largest(bullets_differential), 0.0);
+  for (int i = 0; i < nodes(); ++i)
+    EXPECT_LT((our_differential[i] - bullets_differential[i]).length(), 1e-4 * largest(bullets_differential)) << "node " << i;
 }
 
 // A general small deformation under a large rotation: the force is minus the gradient of the
