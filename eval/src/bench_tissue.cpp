@@ -62,7 +62,7 @@ nlohmann::json run_bench_tissue(const BenchTissueOptions& options) {
       const auto t0 = std::chrono::steady_clock::now();
       const CubeCompressionResult r = run_cube_compression(o);
       const double wall = seconds_since(t0);
-      const char* name = host::fem_model_name(model);
+      const char* name = host::to_string(model);
       std::printf("  %-18s %2d cells/edge %5d nodes: strain %.4f force %.5f N (top %.5f, bottom %.5f) expected %.5f N error %+.4f lateral %.4f, %d steps of %.1f us, %.1f s\n",
                   name, cells, r.nodes_count, r.strain, r.force_n, r.force_top_n, r.force_bottom_n, r.expected_force_n, r.relative_error, r.lateral_strain, r.steps_count,
                   r.step_s * 1e6, wall);
@@ -89,7 +89,7 @@ nlohmann::json run_bench_tissue(const BenchTissueOptions& options) {
                 r.slope_n_per_m, r.expected_slope_n_per_m, r.relative_error);
     for (double f : r.forces_n) std::printf(" %.5f", f);
     std::printf(" N, %.1f s\n", wall);
-    punch.push_back({{"model", host::fem_model_name(o.material.model)}, {"cells_per_radius", k}, {"nodes", r.nodes_count}, {"tetrahedra", r.tetrahedra_count}, {"punch_nodes", r.punch_nodes_count},
+    punch.push_back({{"model", host::to_string(o.material.model)}, {"cells_per_radius", k}, {"nodes", r.nodes_count}, {"tetrahedra", r.tetrahedra_count}, {"punch_nodes", r.punch_nodes_count},
                      {"forces_n", r.forces_n}, {"slope_n_per_m", r.slope_n_per_m}, {"expected_slope_n_per_m", r.expected_slope_n_per_m},
                      {"relative_error", r.relative_error}, {"max_speed_m_per_s", r.max_speed_m_per_s}, {"wall_s", wall}});
     slopes.push_back(r.slope_n_per_m);
@@ -115,9 +115,9 @@ nlohmann::json run_bench_tissue(const BenchTissueOptions& options) {
     const auto t0 = std::chrono::steady_clock::now();
     const CantileverResult r = run_cantilever(o);
     const double wall = seconds_since(t0);
-    std::printf("  %-18s %d cells across %5d nodes: tip %.4f mm expected %.4f mm error %+.4f, %.1f s\n", host::fem_model_name(model), across, r.nodes_count,
+    std::printf("  %-18s %d cells across %5d nodes: tip %.4f mm expected %.4f mm error %+.4f, %.1f s\n", host::to_string(model), across, r.nodes_count,
                 r.tip_deflection_m * 1e3, r.expected_deflection_m * 1e3, r.relative_error, wall);
-    cantilever.push_back({{"model", host::fem_model_name(model)}, {"cells_across", across}, {"nodes", r.nodes_count}, {"tetrahedra", r.tetrahedra_count}, {"tip_deflection_m", r.tip_deflection_m},
+    cantilever.push_back({{"model", host::to_string(model)}, {"cells_across", across}, {"nodes", r.nodes_count}, {"tetrahedra", r.tetrahedra_count}, {"tip_deflection_m", r.tip_deflection_m},
                           {"expected_deflection_m", r.expected_deflection_m}, {"relative_error", r.relative_error}, {"max_speed_m_per_s", r.max_speed_m_per_s},
                           {"wall_s", wall}});
     if (model == kDefaultModel) cantilever_error = r.relative_error;  // the default's finest mesh
@@ -148,9 +148,9 @@ nlohmann::json run_bench_tissue(const BenchTissueOptions& options) {
     const VesselResult r = run_vessel_on_ground(o);
     const double wall = seconds_since(t0);
     std::printf("  %-18s %d x %d x %d cells %5d nodes: vertical %+.4f mm (Roark %+.4f, %+.3f) horizontal %+.4f mm (Roark %+.4f, %+.3f), ovalisation %.4f, %.1f s\n",
-                host::fem_model_name(model), cells[0], cells[1], cells[2], r.nodes_count, r.vertical_change_m * 1e3, r.expected_vertical_change_m * 1e3, r.vertical_relative_error,
+                host::to_string(model), cells[0], cells[1], cells[2], r.nodes_count, r.vertical_change_m * 1e3, r.expected_vertical_change_m * 1e3, r.vertical_relative_error,
                 r.horizontal_change_m * 1e3, r.expected_horizontal_change_m * 1e3, r.horizontal_relative_error, r.ovalisation, wall);
-    vessel.push_back({{"model", host::fem_model_name(model)}, {"cells_through", cells[0]}, {"cells_around", cells[1]}, {"cells_along", cells[2]}, {"nodes", r.nodes_count}, {"tetrahedra", r.tetrahedra_count},
+    vessel.push_back({{"model", host::to_string(model)}, {"cells_through", cells[0]}, {"cells_around", cells[1]}, {"cells_along", cells[2]}, {"nodes", r.nodes_count}, {"tetrahedra", r.tetrahedra_count},
                       {"vertical_change_m", r.vertical_change_m}, {"expected_vertical_change_m", r.expected_vertical_change_m},
                       {"horizontal_change_m", r.horizontal_change_m}, {"expected_horizontal_change_m", r.expected_horizontal_change_m},
                       {"vertical_relative_error", r.vertical_relative_error}, {"horizontal_relative_error", r.horizontal_relative_error},
@@ -190,8 +190,8 @@ nlohmann::json run_bench_tissue(const BenchTissueOptions& options) {
       const StepCostResult r = time_fem_steps(o);
       const char* name = implicit ? "implicit" : "symplectic";
       std::printf("  %-18s %-10s %2d cells/edge %6d nodes %6d tetrahedra, %2d substeps: %8.3f / %8.3f ms per host step (%.0f Hz at the median)%s\n",
-                  host::fem_model_name(model), name, cells, r.nodes_count, r.tetrahedra_count, r.substeps, r.median_ms, r.p95_ms, 1e3 / r.median_ms, r.finite ? "" : "  NOT FINITE");
-      cost.push_back({{"model", host::fem_model_name(model)}, {"stepping", name}, {"cells_per_edge", cells}, {"nodes", r.nodes_count}, {"tetrahedra", r.tetrahedra_count}, {"substeps", r.substeps},
+                  host::to_string(model), name, cells, r.nodes_count, r.tetrahedra_count, r.substeps, r.median_ms, r.p95_ms, 1e3 / r.median_ms, r.finite ? "" : "  NOT FINITE");
+      cost.push_back({{"model", host::to_string(model)}, {"stepping", name}, {"cells_per_edge", cells}, {"nodes", r.nodes_count}, {"tetrahedra", r.tetrahedra_count}, {"substeps", r.substeps},
                       {"median_ms", r.median_ms}, {"p95_ms", r.p95_ms}, {"highest_rate_hz", 1e3 / r.median_ms}, {"finite", r.finite},
                       {"max_speed_m_per_s", r.max_speed_m_per_s}});
       if (model == kDefaultModel && std::abs(r.nodes_count - kAnchorNodes) <= std::abs(anchor_nodes - kAnchorNodes) && r.finite) {

@@ -5,7 +5,7 @@
 
 namespace fissure::host {
 
-const char* fem_model_name(FemModel model) noexcept {
+const char* to_string(FemModel model) noexcept {
   switch (model) {
     case FemModel::kCorotatedSmoothed: return "corotated_smoothed";
     case FemModel::kCorotatedLinear: return "corotated_linear";

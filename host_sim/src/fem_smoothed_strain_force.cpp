@@ -43,6 +43,12 @@ std::uint64_t face_key(std::size_t a, std::size_t b, std::size_t c) {
 // Face k of a tetrahedron is the one opposite its node k.
 constexpr std::array<std::array<int, 3>, 4> kFaceNodes{{{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}}};
 
+// The corotated small strain sym(Rᵀ F) − I of tetrahedron j at the current positions.
+btMatrix3x3 corotated_strain(const btSoftBody& body, int j) {
+  const btSoftBody::TetraScratch& t = body.m_tetraScratches[j];
+  return symmetric_part(t.m_corotation.transpose() * t.m_F) - btMatrix3x3::getIdentity();
+}
+
 }  // namespace
 
 SmoothedStrainElasticityForce::SmoothedStrainElasticityForce(btScalar mu, btScalar lambda, btScalar damping_alpha, btScalar damping_beta)
@@ -109,6 +115,22 @@ SmoothedStrainElasticityForce::BodyScratch& SmoothedStrainElasticityForce::scrat
   return scratch_.back();
 }
 
+template <class Strain>
+void SmoothedStrainElasticityForce::store_strains(const btSoftBody& body, BodyScratch& s, Strain strain) {
+  for (int a = 0; a < body.m_nodes.size(); ++a) s.stack_index[static_cast<std::size_t>(a)] = body.m_nodes[a].index;
+  std::fill(s.node_volumetric_strain.begin(), s.node_volumetric_strain.end(), 0.0);
+  for (int j = 0; j < body.m_tetras.size(); ++j) {
+    const auto t = static_cast<std::size_t>(j);
+    const btMatrix3x3 e = strain(j);
+    s.element_strain[t] = e;
+    const double quarter_volume_trace = 0.25 * body.m_tetras[j].m_element_measure * trace(e);
+    for (const int a : s.tetra_nodes[t]) s.node_volumetric_strain[static_cast<std::size_t>(a)] += quarter_volume_trace;
+  }
+  for (std::size_t a = 0; a < s.node_volumetric_strain.size(); ++a) {
+    if (s.node_volume_m3[a] > 0.0) s.node_volumetric_strain[a] /= s.node_volume_m3[a];
+  }
+}
+
 template <class Strain, class Rotation>
 void SmoothedStrainElasticityForce::add_smoothed_stress_forces(btScalar scale, double mu, double lambda, Strain strain, Rotation rotation, TVStack& out) {
   const double bulk = lambda + 2.0 * mu / 3.0;
@@ -116,23 +138,12 @@ void SmoothedStrainElasticityForce::add_smoothed_stress_forces(btScalar scale, d
     btSoftBody* body = m_softBodies[i];
     if (!body->isActive()) continue;
     BodyScratch& s = scratch_for(*body);
-    std::fill(s.node_volumetric_strain.begin(), s.node_volumetric_strain.end(), 0.0);
-    for (int a = 0; a < body->m_nodes.size(); ++a) s.stack_index[static_cast<std::size_t>(a)] = body->m_nodes[a].index;
     const auto stack_indices = [&s](std::size_t t) {
       const std::array<int, 4>& local = s.tetra_nodes[t];
       return std::array<int, 4>{s.stack_index[static_cast<std::size_t>(local[0])], s.stack_index[static_cast<std::size_t>(local[1])],
                                 s.stack_index[static_cast<std::size_t>(local[2])], s.stack_index[static_cast<std::size_t>(local[3])]};
     };
-    for (int j = 0; j < body->m_tetras.size(); ++j) {
-      const auto t = static_cast<std::size_t>(j);
-      const btMatrix3x3 e = strain(*body, j, stack_indices(t));
-      s.element_strain[t] = e;
-      const double quarter_volume_trace = 0.25 * body->m_tetras[j].m_element_measure * trace(e);
-      for (const int a : s.tetra_nodes[t]) s.node_volumetric_strain[static_cast<std::size_t>(a)] += quarter_volume_trace;
-    }
-    for (std::size_t a = 0; a < s.node_volumetric_strain.size(); ++a) {
-      if (s.node_volume_m3[a] > 0.0) s.node_volumetric_strain[a] /= s.node_volume_m3[a];
-    }
+    store_strains(*body, s, [&](int j) { return strain(*body, j, stack_indices(static_cast<std::size_t>(j))); });
     for (int j = 0; j < body->m_tetras.size(); ++j) {
       const btSoftBody::Tetra& tetra = body->m_tetras[j];
       const auto t = static_cast<std::size_t>(j);
@@ -179,10 +190,7 @@ void add_mass_damping(const btAlignedObjectArray<btSoftBody*>& bodies, btScalar 
 void SmoothedStrainElasticityForce::addScaledElasticForce(btScalar scale, TVStack& force) {
   add_smoothed_stress_forces(
       scale, m_mu, m_lambda,
-      [](const btSoftBody& body, int j, const std::array<int, 4>&) {
-        const btSoftBody::TetraScratch& t = body.m_tetraScratches[j];
-        return symmetric_part(t.m_corotation.transpose() * t.m_F) - btMatrix3x3::getIdentity();
-      },
+      [](const btSoftBody& body, int j, const std::array<int, 4>&) { return corotated_strain(body, j); },
       element_rotation, force);
 }
 
@@ -230,14 +238,7 @@ double SmoothedStrainElasticityForce::totalElasticEnergy(btScalar) {
     btSoftBody* body = m_softBodies[i];
     if (!body->isActive()) continue;
     BodyScratch& s = scratch_for(*body);
-    std::fill(s.node_volumetric_strain.begin(), s.node_volumetric_strain.end(), 0.0);
-    for (int j = 0; j < body->m_tetras.size(); ++j) {
-      const btSoftBody::Tetra& tetra = body->m_tetras[j];
-      const btSoftBody::TetraScratch& t = body->m_tetraScratches[j];
-      const btMatrix3x3 e = symmetric_part(t.m_corotation.transpose() * t.m_F) - btMatrix3x3::getIdentity();
-      s.element_strain[static_cast<std::size_t>(j)] = e;
-      for (const btSoftBody::Node* node : tetra.m_n) s.node_volumetric_strain[local_index(*body, node)] += 0.25 * tetra.m_element_measure * trace(e);
-    }
+    store_strains(*body, s, [body](int j) { return corotated_strain(*body, j); });
     for (int j = 0; j < body->m_tetras.size(); ++j) {
       const auto t = static_cast<std::size_t>(j);
       const double own_volume = body->m_tetras[j].m_element_measure;
@@ -253,10 +254,8 @@ double SmoothedStrainElasticityForce::totalElasticEnergy(btScalar) {
       }
     }
     for (std::size_t a = 0; a < s.node_volumetric_strain.size(); ++a) {
-      if (s.node_volume_m3[a] > 0.0) {
-        const double theta = s.node_volumetric_strain[a] / s.node_volume_m3[a];
-        energy += s.node_volume_m3[a] * 0.5 * bulk * theta * theta;
-      }
+      const double theta = s.node_volumetric_strain[a];
+      energy += s.node_volume_m3[a] * 0.5 * bulk * theta * theta;
     }
   }
   return energy;

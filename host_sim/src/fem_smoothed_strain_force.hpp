@@ -70,6 +70,11 @@ class SmoothedStrainElasticityForce final : public btDeformableLinearElasticityF
   // indices of its nodes) (in each
   // element's corotated frame) with moduli (μ, λ): the elastic force, its differential and the
   // damping all go through here.
+  // The first pass, shared by the forces and the energy: each tetrahedron's strain(j) into
+  // element_strain, its volume-weighted trace averaged at each node into node_volumetric_strain
+  // (θ_a), and the nodes' stack indices refreshed.
+  template <class Strain>
+  static void store_strains(const btSoftBody& body, BodyScratch& s, Strain strain);
   template <class Strain, class Rotation>
   void add_smoothed_stress_forces(btScalar scale, double mu, double lambda, Strain strain, Rotation rotation, TVStack& out);
 

@@ -160,9 +160,9 @@ void read_fem_material(const std::string& file, TableReader& t, SoftBodyDescript
   }
   FemMaterial& m = soft.fem;
   m.model = t.choice<FemModel>("elasticity",
-                               {{fem_model_name(FemModel::kCorotatedSmoothed), FemModel::kCorotatedSmoothed},
-                                {fem_model_name(FemModel::kCorotatedLinear), FemModel::kCorotatedLinear},
-                                {fem_model_name(FemModel::kNeoHookean), FemModel::kNeoHookean}},
+                               {{to_string(FemModel::kCorotatedSmoothed), FemModel::kCorotatedSmoothed},
+                                {to_string(FemModel::kCorotatedLinear), FemModel::kCorotatedLinear},
+                                {to_string(FemModel::kNeoHookean), FemModel::kNeoHookean}},
                                FemModel::kCorotatedSmoothed);
   m.youngs_modulus_pa = t.in_range("youngs_modulus", "pa", kYoungsModulusMinPa, kYoungsModulusMaxPa);
   m.poisson_ratio = t.in_range("poisson", "ratio", kPoissonRatioMin, kPoissonRatioMax);

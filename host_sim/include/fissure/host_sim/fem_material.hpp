@@ -34,7 +34,7 @@ enum class FemModel : std::uint8_t {
 };
 
 /// The scene file's name of a model ("corotated_smoothed", "corotated_linear", "neo_hookean").
-[[nodiscard]] const char* fem_model_name(FemModel model) noexcept;
+[[nodiscard]] const char* to_string(FemModel model) noexcept;
 
 /// A volumetric soft body's material (const model: what the scene says).
 struct FemMaterial {
