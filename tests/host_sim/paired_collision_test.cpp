@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <new>
 #include <random>
 #include <string>
@@ -548,7 +549,8 @@ struct PressResult {
   std::vector<double> force_n;
 };
 
-PressResult press_slab(int cells, const HuntCrossleyParams& hc, double max_depth_m, int steps_to_max) {
+PressResult press_slab(int cells, const HuntCrossleyParams& hc, double max_depth_m, int steps_to_max,
+                       double onset_ramp_s = ThinBodyCollisionParams{}.contact_onset_ramp_s, int hold_steps = 0) {
   test_scene::SoftWorld world(false);
   world.add_slab(0.1, cells);
   BoxToolShape shape;
@@ -557,14 +559,15 @@ PressResult press_slab(int cells, const HuntCrossleyParams& hc, double max_depth
   const ToolNodes tool = ToolNodes::from_box(shape);
   ThinBodyCollisionParams params;
   params.hunt_crossley = hc;
+  params.contact_onset_ramp_s = onset_ramp_s;
   auto collision = make_paired_collision(tool, world.soft(), params);
   CollisionStepResult result;
   ToolPose previous;
   previous.position_world_m = Eigen::Vector3d(0, 0.0021, 0);  // bottom face 0.1 mm above the slab
   PressResult press;
-  for (int s = 1; s <= steps_to_max; ++s) {
+  for (int s = 1; s <= steps_to_max + hold_steps; ++s) {
     ToolPose current = previous;
-    const double depth = max_depth_m * s / steps_to_max;
+    const double depth = max_depth_m * std::min(s, steps_to_max) / steps_to_max;
     current.position_world_m.y() = 0.002 - depth;
     world.step_without_dynamics();
     collision->step(previous, current, kStep_s, world.soft(), result);
@@ -603,6 +606,28 @@ TEST(PairedCollision, FlatSlabForceFollowsTheConfiguredExponent) {
     EXPECT_NEAR(fitted, n, 0.02);
     for (const double f : press.force_n) EXPECT_GT(f, 0.0);
   }
+}
+
+// A node joining the contact brings its force in over contact_onset_ramp_s (hunt_crossley_force.cpp):
+// pressed onto the slab in one step, every corner joins at once and the first step renders h/ramp of
+// the force without the ramp, each step after it h/ramp more, and from the ramp/h-th step on the
+// two are the same force.
+TEST(PairedCollision, AJoiningNodesForceRampsInOverTheOnsetTime) {
+  HuntCrossleyParams hc;
+  hc.k = 1.0e6;
+  hc.lambda = 0.0;
+  const double ramp_s = 0.010;
+  const int ramp_steps = static_cast<int>(std::lround(ramp_s / kStep_s));
+  const PressResult at_once = press_slab(10, hc, 0.002, 1, 0.0, 2 * ramp_steps);
+  const PressResult ramped = press_slab(10, hc, 0.002, 1, ramp_s, 2 * ramp_steps);
+  ASSERT_GT(at_once.force_n.front(), 0.0) << "the plate presses the slab in its first step";
+  EXPECT_NEAR(ramped.force_n.front() / at_once.force_n.front(), kStep_s / ramp_s, 1e-9);
+  for (int s = 1; s < ramp_steps - 1; ++s) {
+    EXPECT_LT(ramped.force_n[static_cast<std::size_t>(s)], at_once.force_n[static_cast<std::size_t>(s)]) << "step " << s;
+    EXPECT_GT(ramped.force_n[static_cast<std::size_t>(s)], ramped.force_n[static_cast<std::size_t>(s - 1)]) << "step " << s;
+  }
+  for (std::size_t s = static_cast<std::size_t>(ramp_steps - 1); s < at_once.force_n.size(); ++s)
+    EXPECT_NEAR(ramped.force_n[s], at_once.force_n[s], 1e-6 * at_once.force_n[s]) << "step " << s;
 }
 
 TEST(PairedCollision, AreaWeightingConvergesWhereThePapersSumScalesWithTheMesh) {
@@ -675,6 +700,11 @@ TEST(PairedCollision, RejectsAnotherSoftBodyAndBadParameters) {
   ThinBodyCollisionParams bad;
   bad.hunt_crossley.n = 0.0;
   EXPECT_THROW((void)make_paired_collision(tool, world.soft(), bad), std::invalid_argument);
+  ThinBodyCollisionParams bad_onset;
+  bad_onset.contact_onset_ramp_s = -1e-3;
+  EXPECT_THROW((void)make_paired_collision(tool, world.soft(), bad_onset), std::invalid_argument);
+  bad_onset.contact_onset_ramp_s = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW((void)make_paired_collision(tool, world.soft(), bad_onset), std::invalid_argument);
 }
 
 }  // namespace

@@ -93,6 +93,8 @@ CollisionModel build_collision_model(const ToolNodes& tool, const btSoftBody& so
     throw std::invalid_argument("thin-body collision: release_distance_m must be >= 0");
   if (!(params.velocity_filter_cutoff_hz > 0.0))
     throw std::invalid_argument("thin-body collision: velocity_filter_cutoff_hz must be > 0");
+  if (!(params.contact_onset_ramp_s >= 0.0) || !std::isfinite(params.contact_onset_ramp_s))
+    throw std::invalid_argument("thin-body collision: contact_onset_ramp_s must be >= 0 (finite)");
   if (!(params.solver_reach_m >= 0.0) || !std::isfinite(params.solver_reach_m))
     throw std::invalid_argument("thin-body collision: solver_reach_m must be >= 0 (finite)");
   const auto& hc = params.hunt_crossley;
@@ -209,6 +211,7 @@ void allocate_collision_data(const CollisionModel& model, CollisionData& data) {
   data.force.hc_corner_stamp.assign(3 * soft_faces, -1);
   data.force.hc_corner_x_prev_m.assign(3 * soft_faces, 0.0);
   data.force.hc_corner_rate_filtered_m_s.assign(3 * soft_faces, 0.0);
+  data.force.hc_corner_onset.assign(3 * soft_faces, 0.0);
 }
 
 StepFrame make_step_frame(const CollisionModel& model, std::int64_t step, const ToolPose& previous,

@@ -205,6 +205,9 @@ struct ForceData {  // stage 5 (hunt_crossley_force.cpp): the ẋ filters, carri
   std::vector<std::int64_t> hc_corner_stamp;
   std::vector<double> hc_corner_x_prev_m;
   std::vector<double> hc_corner_rate_filtered_m_s;
+  // normal_displacement: each corner's onset ramp (0 → 1 over contact_onset_ramp_s from the step
+  // it joins the contact set, index 3·face + corner).
+  std::vector<double> hc_corner_onset;
 };
 
 struct CollisionData {

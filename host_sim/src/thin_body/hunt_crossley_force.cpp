@@ -20,7 +20,9 @@
 //   ≈ 0 (under the centroid measure the triangle's whole x came in with it: a coarse ball under a
 //   held plate jumped between 1.5 N / 6 triangles and 4 N / 13 triangles at ~0.2 mm of depth),
 //   and a held node leaving the face fades out over release_distance (s_v ramps 1 → 0,
-//   enforced_displacement.cpp) instead of dropping a triangle's worth in one step. Summed over
+//   enforced_displacement.cpp) instead of dropping a triangle's worth in one step. A node that
+//   joins elsewhere (carried round a rim, pushed by its neighbours) arrives with its whole x, so
+//   s_v also ramps in over contact_onset_ramp_s from the step the corner joins. Summed over
 //   the triangles around it, vertex v carries s_v·k·x_vⁿ·(its third of each adjacent area): a
 //   nodal quadrature of the contact pressure k·xⁿ over the contacted surface.
 //
@@ -87,10 +89,14 @@ void add_contact(const ContactRecord& record, CollisionStepResult& out) {
 // touches or presses (rim_projection.cpp tents it over the rim) pushes the tool too, or a blade
 // held edge-first in a coarse shell, whose triangles are all draped over its edge, would render
 // nothing. Its share ramps with the rim's gap in front of it as a held node's does (1 touching, 0
-// at release_distance); x is how far the deepest rim point lies behind the triangle's rest plane
-// (at the same barycentric point), weighted as one corner (a third of the rest area), and the
-// force acts along the tool face at that point that faces the triangle most (the proxy's patches
-// are per tool face).
+// at release_distance). The force acts along the tool face through the deepest rim point that
+// faces the triangle most (the proxy's patches are per tool face), and x is the corners' measure
+// taken at the rim point's foot on the triangle: how far that face's plane has advanced past the
+// rest position of the foot (n·(rim point − rest foot)), weighted as one corner (a third of the
+// rest area). So when a corner of the tented triangle joins the contact on that face, its x
+// continues the rim's; x along the triangle's own rest normal counted a shell draped round the
+// rim as 15–31 mm deep where its corners, once held, gave 5.5 mm (a 1.7 → 18 → 0.8 N spike on the
+// convex spatula's rim, docs/decisions.md).
 void rim_contact_forces(const CollisionModel& model, const StepFrame& frame, const btSoftBody& soft, CollisionData& data, double alpha,
                         CollisionStepResult& out) {
   const HuntCrossleyParams& hc = model.params.hunt_crossley;
@@ -115,13 +121,7 @@ void rim_contact_forces(const CollisionModel& model, const StepFrame& frame, con
     const std::array<double, 3> w = barycentric_of_foot(triangle, deepest);
     Eigen::Vector3d rest_point = Eigen::Vector3d::Zero();
     for (std::size_t k = 0; k < 3; ++k) rest_point += w[k] * model.soft.rest_node_world_m[static_cast<std::size_t>(nodes[k])];
-    const Eigen::Vector3d& r0 = model.soft.rest_node_world_m[static_cast<std::size_t>(nodes[0])];
-    const Eigen::Vector3d rest_normal =
-        (model.soft.outward_sign * (model.soft.rest_node_world_m[static_cast<std::size_t>(nodes[1])] - r0)
-                                       .cross(model.soft.rest_node_world_m[static_cast<std::size_t>(nodes[2])] - r0))
-            .normalized();
     const Eigen::Vector3d deepest_world = frame.r_cur * deepest + frame.t_cur;
-    const double x_m = std::max(0.0, rest_normal.dot(rest_point - deepest_world));
     // The tool face through the deepest point that faces the triangle most.
     int plane_index = -1;
     double facing = -std::numeric_limits<double>::infinity();
@@ -134,11 +134,13 @@ void rim_contact_forces(const CollisionModel& model, const StepFrame& frame, con
       }
     }
     if (plane_index < 0) continue;
+    const Eigen::Vector3d normal_world = frame.r_cur * planes[static_cast<std::size_t>(plane_index)].normal_tool;
+    // The corners' measure at the foot: how far that face's plane has advanced past the rest point.
+    const double x_m = std::max(0.0, normal_world.dot(deepest_world - rest_point));
     const double rate = filtered_rate(data.force.hc_stamp[f], data.force.hc_x_prev_m[f], data.force.hc_rate_filtered_m_s[f], frame.step, x_m, x_m, frame.dt_s, alpha);
     const double area_weight = hc.per_unit_area ? model.soft.rest_area_m2[f] : 1.0;
     const double x_pow_n = std::pow(x_m, hc.n);
     const double force = share * (area_weight / 3.0) * std::max(0.0, hc.k * x_pow_n + hc.lambda * x_pow_n * rate);
-    const Eigen::Vector3d normal_world = frame.r_cur * planes[static_cast<std::size_t>(plane_index)].normal_tool;
     add_contact(ContactRecord{face, -1, plane_index, model.params.jaw, deepest_world, normal_world, x_m, rate, share * area_weight / 3.0, force}, out);
   }
 }
@@ -152,6 +154,8 @@ void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, co
   const double alpha = frame.dt_s / (frame.dt_s + time_constant_s);
   const auto& planes = model.tool.planes();
   const bool normal_measure = hc.measure == DeformationMeasure::kNormalDisplacement;
+  const double onset_ramp_per_step =
+      model.params.contact_onset_ramp_s > frame.dt_s ? frame.dt_s / model.params.contact_onset_ramp_s : 1.0;
   for (const int face : data.exclusion.contacted_faces) {
     const auto f = static_cast<std::size_t>(face);
     const Eigen::Vector3d c_now = centroid(model.soft, soft, face, false);
@@ -173,11 +177,14 @@ void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, co
         const int node = model.soft.face_nodes[f][corner];
         const auto v = static_cast<std::size_t>(node);
         if (data.displacement.moved_stamp[v] != frame.step) continue;  // not a colliding vertex
-        const double share = data.displacement.node_share[v];
         const Eigen::Vector3d& rest = model.soft.rest_node_world_m[v];
         const double x = std::max(0.0, plane.offset_m + normal_world.dot(frame.t_cur - rest));
         const double x_start = std::max(0.0, plane.offset_m + normal_prev_world.dot(frame.t_prev - rest));
         const std::size_t slot = 3 * f + corner;
+        const bool joined = data.force.hc_corner_stamp[slot] != frame.step - 1;
+        double& onset = data.force.hc_corner_onset[slot];
+        onset = onset_ramp_per_step >= 1.0 ? 1.0 : (joined ? onset_ramp_per_step : std::min(1.0, onset + onset_ramp_per_step));
+        const double share = data.displacement.node_share[v] * onset;
         // In the world rest frame x is a function of the tool pose and of the plane only, so this
         // plane's x at the previous pose (x_start) is last step's x — unless the triangle's force
         // plane changed (its first colliding corner is now held on another plane, e.g. round a

@@ -47,6 +47,14 @@ struct ThinBodyCollisionParams {
   // ẋ is a finite difference of x filtered by a first-order low-pass with this cut-off
   // (time constant 1/(2π·fc), i.e. ≈1.6 ms lag at 100 Hz).
   double velocity_filter_cutoff_hz = 100.0;
+  // normal_displacement: a soft node that joins a triangle's contact brings its force in over this
+  // time (its share × a ramp 0 → 1), as a leaving node fades over release_distance. A joining node
+  // comes with its whole x = n·(q − p_rest) at once — on the coarse shell 5–30 mm for a node
+  // carried round a rim — and one node's membership moved the held force by 5–50 %; a node that
+  // flickers in and out of the set every other step (a straddling triangle at a blade's edge)
+  // then adds ≤ h/ramp of its share. 10 ms: 1 mm of travel at 0.1 m/s; measured against 5 / 20 ms
+  // in docs/decisions.md ("Contact inside the solver", 2026-12-07 third session).
+  double contact_onset_ramp_s = 0.010;
   // Reported in ContactRecord::jaw so that a clamp can run one instance per jaw.
   int jaw = 0;
   // Where the response acts (scene_description.hpp): after Bullet's step (the call order above)
