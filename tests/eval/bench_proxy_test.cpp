@@ -26,10 +26,9 @@ TEST(BenchProxy, TheRenderedForceStepsAtMostFiveHundredthsOfANewtonPerTickAtEver
   for (const nlohmann::json& row : out["rows"]) {
     const double host_hz = row["host_hz"].get<double>();
     // The rendered step: the tool's own motion across an encoder count at contact stiffness
-    // (cut by the force position) plus the swap blend's walk (which spends at most the rest of
-    // the per-tick budget).
+    // (cut to 95 % in its tick by the force position) plus the swap blend's walk, which spends at
+    // most the rest of the per-tick budget.
     EXPECT_LE(row["max_dforce_n"].get<double>(), kMaxForceStepPerTick_n) << host_hz << " Hz host";
-    EXPECT_LE(row["decomposition"]["max_dforce_motion_n"].get<double>(), kMaxForceStepPerTick_n) << host_hz << " Hz host";
   }
 
   // The lag the sub-count force position adds is reported: w·T at the bench's 2 kHz, 25 µs.
@@ -38,8 +37,9 @@ TEST(BenchProxy, TheRenderedForceStepsAtMostFiveHundredthsOfANewtonPerTickAtEver
   EXPECT_NEAR(out["force_position"]["added_lag_s"].get<double>(), 25e-6, 1e-15);
 }
 
-// The session's own rt rate (1 kHz, RtConfig's default): the tool moves twice as far per tick, so
-// its motion step across a count is the tighter one (0.0496 N at a 50 Hz host on this scene).
+// The session's own rt rate (1 kHz, RtConfig's default): another closed-loop trajectory, on which
+// one encoder count at the reading is a 0.0496 N step at the proxy held fixed (50 Hz host row),
+// the tightest of the bench's rows.
 TEST(BenchProxy, AtTheSessionsOneKilohertzRtRateTheStepsStayWithinTheBoundToo) {
   BenchProxyOptions options;
   options.rt_rate_hz = 1000.0;
@@ -50,7 +50,6 @@ TEST(BenchProxy, AtTheSessionsOneKilohertzRtRateTheStepsStayWithinTheBoundToo) {
   for (const nlohmann::json& row : out["rows"]) {
     const double host_hz = row["host_hz"].get<double>();
     EXPECT_LE(row["max_dforce_n"].get<double>(), kMaxForceStepPerTick_n) << host_hz << " Hz host";
-    EXPECT_LE(row["decomposition"]["max_dforce_motion_n"].get<double>(), kMaxForceStepPerTick_n) << host_hz << " Hz host";
   }
   EXPECT_NEAR(out["force_position"]["added_lag_s"].get<double>(), 50e-6, 1e-15) << "w·T at 1 kHz";
 }
