@@ -15,7 +15,9 @@
 // error is the proxy's, not a different discretisation of the soft body.
 // Measured per row: RMS and peak |F − F_oracle| of the rendered contact force (after blend and
 // fade, before passivity/safety) as % of the oracle's peak |F|, max |ΔF| per tick, and host CPU
-// time (thread CPU clock) per simulated second, plus host step time median/p99.
+// time (thread CPU clock) per simulated second, plus host step time median/p99. Reported with
+// them: the lag rt_core's sub-count force position adds to the rendered contact at this rt rate
+// (force_position.hpp) — what the force's smoothness per tick costs in lag (issue 26).
 #include "fissure/eval/bench_proxy.hpp"
 #include "fissure/session/machine_info.hpp"
 
@@ -38,6 +40,7 @@
 #include "fissure/host_sim/proxy_model.hpp"
 #include "fissure/host_sim/scene_loader.hpp"
 #include "fissure/shared/device_mapping.hpp"
+#include "fissure/rt_core/force_position.hpp"
 #include "fissure/rt_core/hunt_crossley.hpp"
 #include "fissure/rt_core/proxy_intake.hpp"
 #include "fissure/rt_core/rt_config.hpp"
@@ -424,6 +427,9 @@ nlohmann::json run_proxy_bench(const BenchProxyOptions& options) {
               base.name.c_str(), options.rt_rate_hz, duration_s, ticks, peak_oracle);
   std::printf("oracle replay (host every tick) vs oracle: rms %.3g %%, peak %.3g %% (determinism check)\n",
               self_error.rms_pct, self_error.peak_pct);
+  const double force_position_lag_s = rt::force_position_lag_s(1.0 / options.rt_rate_hz);
+  std::printf("force position (sub-count, every row): previous reading's weight %.3g, added lag %.3g us at %.0f Hz\n",
+              rt::kForcePositionPreviousWeight, force_position_lag_s * 1e6, options.rt_rate_hz);
   std::printf("%8s %14s %15s %13s %17s %12s %12s | %9s %9s %9s %9s %9s | %9s %9s %9s %9s %9s\n", "host_hz", "rms_error_pct",
               "peak_error_pct", "max_dforce_n", "host_cpu_s_per_s", "step_ms_med", "step_ms_p99", "blend%", "diverge%",
               "model%", "host_div%", "mdl_v_hst%", "dF_swap", "dF_betw", "dF_unbl", "dF_motion", "dF_blend");
@@ -505,6 +511,9 @@ nlohmann::json run_proxy_bench(const BenchProxyOptions& options) {
       {"host_divergence", "row host force at its steps - oracle host force at the same tick"},
       {"model_vs_host", "oracle's proxy from the row's host tick at the tick's pose - oracle host's own force at that pose"},
       {"note", "blend + divergence + model = rendered - oracle exactly (per tick, as vectors); all % of the oracle's peak |F|"}};
+  out["force_position"] = {{"previous_weight", rt::kForcePositionPreviousWeight},
+                           {"added_lag_s", force_position_lag_s},
+                           {"note", "the contact is evaluated at p_k - w*(p_k - p_{k-1}): a constant velocity lags by w*T"}};
   out["targets"] = {{"rms_error_pct_at_100_hz", 2.0}, {"rms_error_pct_at_1000_hz", 0.5}, {"max_dforce_n", 0.05}};
   out["rows"] = rows;
   out["machine"] = machine_info();

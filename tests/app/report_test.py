@@ -106,6 +106,7 @@ def main():
         check("could not be made" not in report and "could not evaluate" not in report,
               "a section or target could not be made from the fixture JSON")
         check("bench all --out out/bench --docs docs" in report, "the regeneration command is not in the report")
+        check("added lag 25 µs" in report, "the force position's added lag (proxy.json force_position) is not in the report")
         check("Intel(R) Xeon(R) Processor @ 2.10GHz" in report and "PREEMPT_DYNAMIC" in report,
               "the machine (CPU model, kernel) is not in the report")
         links = re.findall(r"!\[[^\]]*\]\(([^)]+)\)", report)

@@ -281,6 +281,12 @@ def section_pareto(report, data, problems, targets):
                          [[fmt(r["host_hz"]), fmt(r["rms_error_pct"]), fmt(r["peak_error_pct"]), fmt(r["max_dforce_n"]),
                            fmt(r["host_cpu_s_per_s"]), fmt(r.get("host_step_ms", {}).get("median")),
                            fmt(r.get("crossed_nodes_max"))] for r in rows]))
+        force_position = proxy.get("force_position")
+        if force_position:
+            report.add("")
+            report.add(f"rt_core evaluates the contact at a sub-count force position (weight of the previous reading "
+                       f"{fmt(force_position.get('previous_weight'))}): added lag {fmt(force_position.get('added_lag_s', 0.0) * 1e6)} µs "
+                       f"at the rt rate, every row.")
         report.add(targets_table([t for t in targets if t.section == "proxy"]))
     else:
         missing(report, "proxy", problems)
