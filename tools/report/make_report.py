@@ -287,6 +287,7 @@ def section_pareto(report, data, problems, targets):
             report.add(f"rt_core evaluates the contact at a sub-count force position (weight of the previous reading "
                        f"{fmt(force_position.get('previous_weight'))}): added lag {fmt(force_position.get('added_lag_s', 0.0) * 1e6)} µs "
                        f"at the rt rate, every row.")
+            report.add("")  # a table after a paragraph line needs a blank line to render as a table
         report.add(targets_table([t for t in targets if t.section == "proxy"]))
     else:
         missing(report, "proxy", problems)
