@@ -183,7 +183,7 @@ void hunt_crossley_force(const CollisionModel& model, const StepFrame& frame, co
         const std::size_t slot = 3 * f + corner;
         const bool joined = data.force.hc_corner_stamp[slot] != frame.step - 1;
         double& onset = data.force.hc_corner_onset[slot];
-        onset = onset_ramp_per_step >= 1.0 ? 1.0 : (joined ? onset_ramp_per_step : std::min(1.0, onset + onset_ramp_per_step));
+        onset = joined ? onset_ramp_per_step : std::min(1.0, onset + onset_ramp_per_step);
         const double share = data.displacement.node_share[v] * onset;
         // In the world rest frame x is a function of the tool pose and of the plane only, so this
         // plane's x at the previous pose (x_start) is last step's x — unless the triangle's force
