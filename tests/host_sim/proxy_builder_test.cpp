@@ -364,12 +364,16 @@ TEST_P(PaperSceneProxy, RtEvaluationAtTheHostPoseIsWithinOnePercentOfTheHostForc
     Eigen::Vector3d host_total = Eigen::Vector3d::Zero();
     for (int jaw = 0; jaw < model.jaw_count; ++jaw) {
       const auto j = static_cast<std::size_t>(jaw);
-      const Eigen::Vector3d host_part = step.part_force_world_n[j];
+      // The patch carries the normal (Hunt-Crossley) law; in-solver friction is rendered by
+      // rt_core's friction cone from the part's friction state (bench grasp), not by the patch.
+      const Eigen::Vector3d host_part = step.part_force_world_n[j] - step.part_results[j].friction_force_on_tool_world_n;
       host_total += host_part;
       const Eigen::Vector3d rt_part = forces.force_world_n[static_cast<std::size_t>(model.part_of_jaw[j])];
       if (clamp) expect_within_one_percent(rt_part, host_part, GetParam() + " jaw " + std::to_string(jaw) + " t=" + std::to_string(t));
     }
-    EXPECT_LE((host_total - step.force_on_tool_world_n).norm(), 1e-9 * (1.0 + host_total.norm()));
+    Eigen::Vector3d host_friction = Eigen::Vector3d::Zero();
+    for (int p = 0; p < step.part_count; ++p) host_friction += step.part_results[static_cast<std::size_t>(p)].friction_force_on_tool_world_n;
+    EXPECT_LE((host_total + host_friction - step.force_on_tool_world_n).norm(), 1e-9 * (1.0 + host_total.norm()));
     expect_within_one_percent(forces.force_world_n[0] + forces.force_world_n[1] + forces.force_world_n[2], host_total,
                               GetParam() + " t=" + std::to_string(t));
     if (step.contact_count > 0) ++steps_in_contact;
@@ -431,7 +435,10 @@ HeldProxyError held_proxy_error(const std::string& scene_name, int steps_per_pro
     // rt_core's view of this step, with the proxy it holds (built up to steps_per_proxy − 1 steps ago).
     rt::take_latest_proxy(*exchange, *state, now_ns);
     if (state->have_proxy) {
-      const Eigen::Vector3d error = rt.total(rt::active_proxy(*state)) - step.force_on_tool_world_n;
+      // The normal law only, as above: in-solver friction goes to rt_core's friction cone.
+      Eigen::Vector3d host_normal = step.force_on_tool_world_n;
+      for (int p = 0; p < step.part_count; ++p) host_normal -= step.part_results[static_cast<std::size_t>(p)].friction_force_on_tool_world_n;
+      const Eigen::Vector3d error = rt.total(rt::active_proxy(*state)) - host_normal;
       sum_sq += error.squaredNorm();
       ++compared;
     }

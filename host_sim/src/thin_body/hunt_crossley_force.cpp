@@ -137,7 +137,15 @@ void rim_contact_forces(const CollisionModel& model, const StepFrame& frame, con
     const Eigen::Vector3d normal_world = frame.r_cur * planes[static_cast<std::size_t>(plane_index)].normal_tool;
     // The corners' measure at the foot: how far that face's plane has advanced past the rest point.
     const double x_m = std::max(0.0, normal_world.dot(deepest_world - rest_point));
-    const double rate = filtered_rate(data.force.hc_stamp[f], data.force.hc_x_prev_m[f], data.force.hc_rate_filtered_m_s[f], frame.step, x_m, x_m, frame.dt_s, alpha);
+    // ẋ is the tool's advance at this foot: the same rest point and tool point at the previous
+    // pose. The foot itself slides over the rest surface as the tissue is carried round the rim,
+    // and differencing x across that slide counted the tissue's tangential travel as indentation
+    // (the rounded rim of convex-spatula-sphere: ẋ up to 1.4 × the tool's speed, docs/decisions.md).
+    const Eigen::Vector3d normal_prev_world = frame.r_prev * planes[static_cast<std::size_t>(plane_index)].normal_tool;
+    const double x_start_m = std::max(0.0, normal_prev_world.dot(frame.r_prev * deepest + frame.t_prev - rest_point));
+    if (data.force.hc_stamp[f] == frame.step - 1) data.force.hc_x_prev_m[f] = x_start_m;
+    const double rate =
+        filtered_rate(data.force.hc_stamp[f], data.force.hc_x_prev_m[f], data.force.hc_rate_filtered_m_s[f], frame.step, x_m, x_start_m, frame.dt_s, alpha);
     const double area_weight = hc.per_unit_area ? model.soft.rest_area_m2[f] : 1.0;
     const double x_pow_n = std::pow(x_m, hc.n);
     const double force = share * (area_weight / 3.0) * std::max(0.0, hc.k * x_pow_n + hc.lambda * x_pow_n * rate);
