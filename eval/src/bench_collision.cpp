@@ -237,7 +237,7 @@ void run_motion_cells(const BenchCollisionOptions& o, nlohmann::json& out) {
   }
   out["lever"] = lever;
 
-  const SceneDescription clamp = with_response(host::load_scene(host::resolve_scene_path("clamp-sphere")), o.contact_response);
+  const SceneDescription clamp = host::clamp_cell_scene(o.contact_response, o.in_solver_tool_friction);
   std::printf("\n1d. Clamp release: clamp-sphere's script (close, hold, open fully) after settling; the larger jaw's |F| from the %dth fully open step\n",
               host::kClampOpenGraceSteps + 1);
   std::printf("%-8s %-7s | %9s %9s %9s | %7s %9s %9s\n", "settle s", "method", "F_max N", "open N", "open stp", "crossed", "cut max", "cut stp");

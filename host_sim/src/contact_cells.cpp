@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "fissure/host_sim/host_simulation.hpp"
+#include "fissure/host_sim/scene_loader.hpp"
 
 namespace fissure::host {
 
@@ -71,6 +72,16 @@ ClampReleaseResult run_clamp_release(const SceneDescription& clamp_scene, SceneC
     result.take(r, sim.triangles_cut_by_tool(kInsideToleranceM));
   }
   return result;
+}
+
+SceneDescription clamp_cell_scene(ContactResponse response, bool tool_friction) {
+  SceneDescription scene = load_scene(resolve_scene_path("clamp-sphere"));
+  scene.simulation.contact_response = response;
+  if (response != ContactResponse::kInSolver || !tool_friction) {
+    scene.tool.friction_static_ratio = 0.0;
+    scene.tool.friction_kinetic_ratio = 0.0;
+  }
+  return scene;
 }
 
 }  // namespace fissure::host

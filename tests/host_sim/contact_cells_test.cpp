@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 #include "fissure/host_sim/contact_cells.hpp"
 #include "fissure/host_sim/scene_loader.hpp"
@@ -53,43 +54,30 @@ TEST(LeverCell, DISABLED_NoCutTriangleAndAQuietHold) {
 }
 
 // The clamp squeezes the ball and opens along clamp-sphere's script: once the jaws are fully open
-// (gap 0.12 m > the ball's 0.10 m) nothing may hold on to them. With the paper's centroid
-// distance a node wrapped round jaw A's rim was dragged along and kept ≈ 13–16 N on the jaw all
-// the way open (x counted the ball's sideways travel as indentation).
-TEST(ClampReleaseCell, OpeningReleasesTheBallAfterSettling0_3s) {
-  const ClampReleaseResult c = run_clamp_release(load_scene(resolve_scene_path("clamp-sphere")), SceneCollisionMethod::kPaired, 0.3);
-  std::printf("[clamp] settled 0.3 s: max %.3f N per jaw over the script, after opening %.4f N\n", c.script_max_force_n, c.open_force_max_n);
-  EXPECT_GT(c.script_max_force_n, 0.5) << "the clamp must grab the ball";
-  EXPECT_GT(c.open_steps, kClampOpenGraceSteps) << "the script must open the clamp fully";
-  EXPECT_LT(c.open_force_max_n, kOpenForceMaxN);
-  EXPECT_EQ(c.crossed_nodes, 0);
-}
-
-// The same release after the other settling times of issue 22's clamp cell. NOT MET (disabled so
-// that it stays visible; run with --gtest_also_run_disabled_tests). Diagnosis (0.5 s): the squeezed
-// ball bulges under jaw A's tip, and a soft node goes round the tip onto the jaw's outer face, a
-// legal pass round the rim; its triangles, whose other corners stay inside the gap, are then cut
-// by the 3 mm jaw, and the node, held on the outer face, is carried outwards as the jaw opens.
-TEST(ClampReleaseCell, DISABLED_OpeningReleasesTheBallAfterAnySettlingTime) {
-  const SceneDescription scene = load_scene(resolve_scene_path("clamp-sphere"));
+// (gap 0.12 m > the ball's 0.10 m) nothing may hold on to them, after every settling time of issue
+// 22's clamp cell, with the after_step response too (frictionless jaws: it has no friction), the
+// ball on its bed as clamp-sphere ships it. On a free ball this response does not let go after 0.1,
+// 0.2 and 0.5 s (9.98 / 9.59 / 11.59 N open, docs/decisions.md): the squeezed ball bulges under jaw
+// A's tip, a soft node goes round the tip onto the jaw's outer face and is carried outwards as the
+// jaw opens. The bed holds the ball's bottom, so it neither bulges under the tip nor rolls.
+TEST(ClampReleaseCell, OpeningReleasesTheBeddedBallAfterAnySettlingTime) {
+  const SceneDescription scene = clamp_cell_scene(ContactResponse::kAfterStep, false);
   for (const double settle_s : {0.1, 0.2, 0.3, 0.5}) {
     const ClampReleaseResult c = run_clamp_release(scene, SceneCollisionMethod::kPaired, settle_s);
-    std::printf("[clamp] settled %.2f s: max %.3f N per jaw over the script, after opening %.4f N\n", settle_s, c.script_max_force_n,
+    std::printf("[clamp] after_step, settled %.2f s: max %.3f N per jaw over the script, after opening %.4f N\n", settle_s, c.script_max_force_n,
                 c.open_force_max_n);
-    EXPECT_GT(c.open_steps, kClampOpenGraceSteps) << "settled " << settle_s << " s";
+    EXPECT_GT(c.script_max_force_n, 0.5) << "settled " << settle_s << " s: the clamp must grab the ball";
+    EXPECT_GT(c.open_steps, kClampOpenGraceSteps) << "settled " << settle_s << " s: the script must open the clamp fully";
     EXPECT_LT(c.open_force_max_n, kOpenForceMaxN) << "settled " << settle_s << " s";
+    EXPECT_EQ(c.crossed_nodes, 0) << "settled " << settle_s << " s";
   }
 }
 
-// In-solver response (issue 22, contact_response = "in_solver", experimental): the levering blade
-// (the in-solver cells' scene, host::in_solver_plunge_scene) on the paper's 128-face ball and on a
-// 1280-face one keeps the paired guarantees, cuts no soft triangle on any step and holds the turned
-// blade with ≤ 1 % jitter, and the opened
-// clamp lets go after every settling time, cutting none either.
-SceneDescription in_solver(SceneDescription scene) {
-  scene.simulation.contact_response = ContactResponse::kInSolver;
-  return scene;
-}
+// In-solver response (issue 22, contact_response = "in_solver"): the levering blade (the in-solver
+// cells' scene, host::in_solver_plunge_scene) on the paper's 128-face ball and on a 1280-face one
+// keeps the paired guarantees, cuts no soft triangle on any step and holds the turned blade with
+// ≤ 1 % jitter; the opened clamp (clamp-sphere as shipped, and with frictionless jaws) lets go
+// after every settling time, cutting none either.
 
 TEST(LeverCell, InSolverCrossesNoNodeCutsNoTriangleAndKeepsContactThroughTheTurn) {
   for (const int faces : {128, 1280}) {
@@ -111,16 +99,19 @@ TEST(LeverCell, InSolverCrossesNoNodeCutsNoTriangleAndKeepsContactThroughTheTurn
 }
 
 TEST(ClampReleaseCell, InSolverOpeningReleasesTheBallAfterAnySettlingTime) {
-  const SceneDescription scene = in_solver(load_scene(resolve_scene_path("clamp-sphere")));
-  for (const double settle_s : {0.1, 0.2, 0.3, 0.5}) {
-    const ClampReleaseResult c = run_clamp_release(scene, SceneCollisionMethod::kPaired, settle_s);
-    std::printf("[clamp] in_solver, settled %.2f s: max %.3f N per jaw over the script, after opening %.4f N, cut max %d\n", settle_s,
-                c.script_max_force_n, c.open_force_max_n, c.max_cut_triangles);
-    EXPECT_GT(c.script_max_force_n, 0.5) << "settled " << settle_s << " s: the clamp must grab the ball";
-    EXPECT_GT(c.open_steps, kClampOpenGraceSteps) << "settled " << settle_s << " s";
-    EXPECT_LT(c.open_force_max_n, kOpenForceMaxN) << "settled " << settle_s << " s";
-    EXPECT_EQ(c.crossed_nodes, 0) << "settled " << settle_s << " s";
-    EXPECT_EQ(c.max_cut_triangles, 0) << "settled " << settle_s << " s";
+  for (const bool friction : {true, false}) {
+    const SceneDescription scene = clamp_cell_scene(ContactResponse::kInSolver, friction);
+    for (const double settle_s : {0.1, 0.2, 0.3, 0.5}) {
+      const ClampReleaseResult c = run_clamp_release(scene, SceneCollisionMethod::kPaired, settle_s);
+      std::printf("[clamp] in_solver, jaw friction %s, settled %.2f s: max %.3f N per jaw over the script, after opening %.4f N, cut max %d\n",
+                  friction ? "0.5 / 0.4" : "off", settle_s, c.script_max_force_n, c.open_force_max_n, c.max_cut_triangles);
+      const std::string cell = std::string(friction ? "with" : "without") + " friction, settled " + std::to_string(settle_s) + " s";
+      EXPECT_GT(c.script_max_force_n, 0.5) << cell << ": the clamp must grab the ball";
+      EXPECT_GT(c.open_steps, kClampOpenGraceSteps) << cell;
+      EXPECT_LT(c.open_force_max_n, kOpenForceMaxN) << cell;
+      EXPECT_EQ(c.crossed_nodes, 0) << cell;
+      EXPECT_EQ(c.max_cut_triangles, 0) << cell;
+    }
   }
 }
 
