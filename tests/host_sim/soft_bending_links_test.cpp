@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <cstdio>
 #include <memory>
 #include <set>
 #include <stdexcept>
@@ -64,6 +66,7 @@ TEST(BendingLinks, SameLinksAsBulletsGenerateBendingConstraints) {
     EXPECT_EQ(ours->m_links.size(), edges + appended);
     EXPECT_EQ(bending_pairs_of(*ours), bending_pairs_of(*bullets)) << distance;
     EXPECT_GT(appended, edges / 2) << distance;
+    std::printf("vessel shell: %d edge links, %d bending links at distance %d\n", edges, appended, distance);
   }
 }
 
@@ -137,6 +140,8 @@ TEST(BendingLinks, TheShippedVesselKeepsItsSectionOnTheGroundAndTheShellAloneDoe
   const SoftCylinder& c = std::get<SoftCylinder>(scene.soft_bodies.front().shape);
   const double diameter_m = 2.0 * c.radius_m, top_m = c.center_world_m[1] + c.radius_m;
   const Section bent = settled_section(scene, 0.5);
+  std::printf("bending links: section %.2f / %.2f mm, ovalisation %.2f %%, top %.2f mm\n", 1e3 * bent.min_diameter_m, 1e3 * bent.max_diameter_m,
+              100.0 * (bent.max_diameter_m - bent.min_diameter_m) / diameter_m, 1e3 * bent.top_m);
   EXPECT_LE((bent.max_diameter_m - bent.min_diameter_m) / diameter_m, 0.10);
   EXPECT_GE(bent.min_diameter_m, 0.95 * diameter_m);
   EXPECT_GE(bent.top_m, top_m - 1.0e-3) << "the top falls less than 1 mm";
@@ -144,6 +149,8 @@ TEST(BendingLinks, TheShippedVesselKeepsItsSectionOnTheGroundAndTheShellAloneDoe
   SceneDescription shell = scene;
   shell.soft_bodies.front().bending_stiffness_ratio = 0.0;
   const Section flat = settled_section(shell, 0.5);
+  std::printf("edge links alone: section %.2f / %.2f mm, ovalisation %.2f %%, top %.2f mm\n", 1e3 * flat.min_diameter_m, 1e3 * flat.max_diameter_m,
+              100.0 * (flat.max_diameter_m - flat.min_diameter_m) / diameter_m, 1e3 * flat.top_m);
   EXPECT_GE((flat.max_diameter_m - flat.min_diameter_m) / diameter_m, 0.5) << "edge links alone: the section flattens";
   EXPECT_LE(flat.top_m, top_m - 2.0e-3);
 }
