@@ -56,6 +56,7 @@ int append_bending_links(btSoftBody& body, int distance, double stiffness_ratio)
   if (!(stiffness_ratio > 0.0 && stiffness_ratio <= 1.0)) {
     throw std::invalid_argument("a bending link's stiffness ratio is in (0, 1] (got " + std::to_string(stiffness_ratio) + ")");
   }
+  if (body.m_nodes.size() == 0) return 0;
   const btSoftBody::Node* base = &body.m_nodes[0];
   std::vector<std::array<int, 2>> links;
   links.reserve(static_cast<std::size_t>(body.m_links.size()));
