@@ -250,6 +250,10 @@ TEST(SceneLoader, BendingLinksAreOptionalAndRangeChecked) {
                "has no effect without bending links: set bending_stiffness_ratio > 0");
   const std::string wrong_unit = replace(with, "bending_stiffness_ratio = 0.3", "bending_stiffness_pa = 0.3");
   expect_error(load_error(wrong_unit), line_of(wrong_unit, "bending_stiffness_pa"), "soft_body.bending_stiffness_pa", "wrong unit");
+  // A shell's links only: an FEM body has no links to add them to, and refuses the key as it
+  // refuses the other Bullet ratios.
+  const std::string fem = replace(read(kScenes / "spatula-fem-lobe.toml"), "model = \"fem\"", "model = \"fem\"\nbending_stiffness_ratio = 0.3");
+  expect_error(load_error(fem), line_of(fem, "bending_stiffness_ratio"), "soft_body.bending_stiffness_ratio", "unknown key");
 }
 
 // Bullet's pose matching collapses a body whose rest pose matrix it cannot decompose
