@@ -25,6 +25,7 @@
 #include "fissure/config/session_tables.hpp"
 #include "fissure/config/table_reader.hpp"
 
+#include "fissure/host_sim/soft_bending_links.hpp"
 #include "fissure/host_sim/soft_body_builder.hpp"
 #include "fissure/host_sim/tet_mesh_checks.hpp"
 #include "fissure/host_sim/tet_mesh_file.hpp"
@@ -249,6 +250,11 @@ void read_soft_body(const std::string& file, TableReader& t, SoftBodyDescription
   soft.pressure_kpr = t.in_range("pressure", "kpr", 0.0, 1e9);
   soft.volume_conservation_kvc = t.in_range("volume_conservation", "kvc", 0.0, 1e9);
   soft.shape_matching_ratio = t.in_range("shape_matching", "ratio", 0.0, 1.0, 0.0);
+  soft.bending_stiffness_ratio = t.in_range("bending_stiffness", "ratio", 0.0, 1.0, 0.0);
+  soft.bending_distance_count = t.count("bending_distance", 2, kMaxBendingDistance, 2);
+  if (soft.bending_stiffness_ratio == 0.0 && t.find("bending_distance", "count") != nullptr) {
+    t.fail(t.line_for("bending_distance", "count"), "bending_distance_count", "has no effect without bending links: set bending_stiffness_ratio > 0 or remove it");
+  }
   soft.damping_ratio = t.in_range("damping", "ratio", 0.0, 1.0);
   soft.friction_ratio = t.in_range("friction", "ratio", 0.0, 1.0);
   soft.position_iterations_count = t.count("position_iterations", 1, 1000);

@@ -19,6 +19,7 @@
 
 #include "fissure/host_sim/mesh_checks.hpp"
 #include "fissure/host_sim/mesh_file.hpp"
+#include "fissure/host_sim/soft_bending_links.hpp"
 #include "fissure/host_sim/tet_mesh_checks.hpp"
 #include "fissure/host_sim/tet_mesh_file.hpp"
 
@@ -312,6 +313,7 @@ btSoftBody* build_soft_body(btSoftBodyWorldInfo& world_info, const SoftBodyDescr
     pinned = mesh.pinned_vertices;
   }
   body->m_materials[0]->m_kLST = static_cast<btScalar>(d.linear_stiffness_ratio);
+  if (d.bending_stiffness_ratio > 0.0) (void)append_bending_links(*body, d.bending_distance_count, d.bending_stiffness_ratio);
   body->m_cfg.kPR = static_cast<btScalar>(d.pressure_kpr);
   body->m_cfg.kVC = static_cast<btScalar>(d.volume_conservation_kvc);
   body->m_cfg.kDP = static_cast<btScalar>(d.damping_ratio);

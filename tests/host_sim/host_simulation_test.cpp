@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -12,6 +13,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "fissure/host_sim/scene_loader.hpp"
@@ -72,6 +74,36 @@ INSTANTIATE_TEST_SUITE_P(Scenes, PaperScene, ::testing::Values("spatula-sphere",
                            for (char& c : name) c = c == '-' ? '_' : c;
                            return name;
                          });
+
+// clamp-vessel on the in-solver response (issue 22's target: an opened jaw carries 0 N within
+// 5 ms). Its vessel has bending links (soft_bending_links.hpp): squeezed into an oval, it springs
+// back round, and both jaws carry 0 N once the gap exceeds its diameter and both collision
+// margins. The same shell of edge links alone crumples into a bag round jaw A and is dragged open
+// with it (43.5 N at full open; docs/decisions.md, "Tissue (issue 24)").
+TEST(HostSimulation, TheBendingVesselLetsGoOfTheOpenedClampOnTheInSolverResponse) {
+  SceneDescription scene = load_scene(resolve_scene_path("clamp-vessel"));
+  ASSERT_GT(scene.soft_bodies.front().bending_stiffness_ratio, 0.0);
+  scene.simulation.contact_response = ContactResponse::kInSolver;
+  const SoftCylinder& vessel = std::get<SoftCylinder>(scene.soft_bodies.front().shape);
+  const double clear_gap_m = 2.0 * vessel.radius_m + 2.0 * scene.soft_bodies.front().collision_margin_m;
+  const RunSummary run = run_scripted(scene, std::nullopt, 0.5);
+  EXPECT_EQ(run.crossed_max, 0);
+  EXPECT_TRUE(run.finite);
+  const auto closed = static_cast<std::size_t>(std::max_element(run.larger_part_force_n.begin(), run.larger_part_force_n.end()) - run.larger_part_force_n.begin());
+  EXPECT_GT(run.larger_part_force_n[closed], 0.5) << "the jaws squeeze the vessel";
+  int open_steps = 0;
+  for (std::size_t i = closed; i < run.jaw_gap_m.size(); ++i) {
+    if (run.jaw_gap_m[i] < clear_gap_m) continue;
+    ++open_steps;
+    EXPECT_EQ(run.larger_part_force_n[i], 0.0) << "step " << i << ", gap " << run.jaw_gap_m[i] << " m";
+  }
+  EXPECT_GT(open_steps, 100) << "the script opens the jaws past the vessel";
+
+  SceneDescription shell = scene;
+  shell.soft_bodies.front().bending_stiffness_ratio = 0.0;
+  const RunSummary bag = run_scripted(shell, std::nullopt, 0.5);
+  EXPECT_GT(bag.larger_part_force_n.back(), 10.0) << "the shell alone is dragged open by a jaw";
+}
 
 // Two soft bodies ([[soft_body]], spatula-fissure): the blade slides into the cleft touching
 // both lobes, then pushes the right lobe aside; every contact names its body, no node of either

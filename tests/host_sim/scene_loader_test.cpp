@@ -221,6 +221,41 @@ TEST(SceneLoader, ShapeMatchingIsOptionalAndRangeChecked) {
   expect_error(load_error(bad), line_of(bad, "shape_matching_ratio"), "soft_body.shape_matching_ratio", "must be in");
 }
 
+// Bending links (soft_bending_links.hpp): optional, off by default; the stiffness is a Bullet
+// ratio in [0, 1], the distance an edge count in [2, kMaxBendingDistance] that means nothing
+// without the links, so it is refused alone rather than silently ignored.
+TEST(SceneLoader, BendingLinksAreOptionalAndRangeChecked) {
+  const std::string good = read(kScenes / "clamp-sphere.toml");
+  ASSERT_EQ(good.find("bending_"), std::string::npos) << "a scene without bending links";
+  const SoftBodyDescription plain = load_scene_text(good, "good.toml", kScenes).soft_bodies.front();
+  EXPECT_EQ(plain.bending_stiffness_ratio, 0.0);
+  EXPECT_EQ(plain.bending_distance_count, 2);
+  const std::string with = replace(good, "damping_ratio = 0.02", "damping_ratio = 0.02\nbending_stiffness_ratio = 0.3\nbending_distance_count = 3");
+  const SoftBodyDescription bent = load_scene_text(with, "good.toml", kScenes).soft_bodies.front();
+  EXPECT_EQ(bent.bending_stiffness_ratio, 0.3);
+  EXPECT_EQ(bent.bending_distance_count, 3);
+
+  const std::string stiff = replace(with, "bending_stiffness_ratio = 0.3", "bending_stiffness_ratio = 1.5");
+  expect_error(load_error(stiff), line_of(stiff, "bending_stiffness_ratio"), "soft_body.bending_stiffness_ratio", "must be in [0, 1] (got 1.5)");
+  const std::string negative = replace(with, "bending_stiffness_ratio = 0.3", "bending_stiffness_ratio = -0.1");
+  expect_error(load_error(negative), line_of(negative, "bending_stiffness_ratio"), "soft_body.bending_stiffness_ratio", "must be in [0, 1] (got -0.1)");
+  const std::string near = replace(with, "bending_distance_count = 3", "bending_distance_count = 1");
+  expect_error(load_error(near), line_of(near, "bending_distance_count"), "soft_body.bending_distance_count", "must be in [2, 4] (got 1)");
+  const std::string far = replace(with, "bending_distance_count = 3", "bending_distance_count = 5");
+  expect_error(load_error(far), line_of(far, "bending_distance_count"), "soft_body.bending_distance_count", "must be in [2, 4] (got 5)");
+  const std::string fractional = replace(with, "bending_distance_count = 3", "bending_distance_count = 2.5");
+  expect_error(load_error(fractional), line_of(fractional, "bending_distance_count"), "soft_body.bending_distance_count", "expected an integer");
+  const std::string alone = replace(with, "bending_stiffness_ratio = 0.3\n", "");
+  expect_error(load_error(alone), line_of(alone, "bending_distance_count"), "soft_body.bending_distance_count",
+               "has no effect without bending links: set bending_stiffness_ratio > 0");
+  const std::string wrong_unit = replace(with, "bending_stiffness_ratio = 0.3", "bending_stiffness_pa = 0.3");
+  expect_error(load_error(wrong_unit), line_of(wrong_unit, "bending_stiffness_pa"), "soft_body.bending_stiffness_pa", "wrong unit");
+  // A shell's links only: an FEM body has no links to add them to, and refuses the key as it
+  // refuses the other Bullet ratios.
+  const std::string fem = replace(read(kScenes / "spatula-fem-lobe.toml"), "model = \"fem\"", "model = \"fem\"\nbending_stiffness_ratio = 0.3");
+  expect_error(load_error(fem), line_of(fem, "bending_stiffness_ratio"), "soft_body.bending_stiffness_ratio", "unknown key");
+}
+
 // Bullet's pose matching collapses a body whose rest pose matrix it cannot decompose
 // (kPoseMatchingMinNormProduct_m4): the paper's ball at 30 mm radius is refused where the key
 // is, with the body's radius of gyration; at 32 mm, or without pose matching, it loads.

@@ -121,6 +121,11 @@ struct SoftBodyDescription {
   /// Bullet config kMT ∈ [0, 1]: pose (shape) matching towards the rest shape, the only
   /// restoring force a pressure-less edge-link shell has against being dented (0: off).
   double shape_matching_ratio = 0.0;
+  /// Bending links (soft_bending_links.hpp): Bullet kLST ∈ [0, 1] of links between nodes
+  /// bending_distance_count edges apart, which resist the folding an edge-link shell has none
+  /// against (0: no bending links, the paper's shell).
+  double bending_stiffness_ratio = 0.0;
+  int bending_distance_count = 2;          ///< graph distance of the bending links' nodes, ≥ 2
   double damping_ratio = 0.01;             ///< Bullet config kDP ∈ [0, 1]
   double friction_ratio = 0.2;             ///< Bullet config kDF ∈ [0, 1]
   int position_iterations_count = 4;       ///< Bullet config piterations
