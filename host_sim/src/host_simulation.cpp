@@ -124,6 +124,11 @@ HostSimulation::HostSimulation(const SceneDescription& scene, std::optional<Scen
     params.friction_static_ratio = scene_.tool.friction_static_ratio;
     params.friction_kinetic_ratio = scene_.tool.friction_kinetic_ratio;
     params.friction_shear_damping_pa_s_per_m = scene_.tool.friction_shear_damping_pa_s_per_m;
+    // The onset ramp answers the in-solver response's joins (a node carried round a rim arrives with
+    // its whole x). A force that lags its position on the way in is active to the hand (less force
+    // pressing in than coming out): after_step's nodes join at the tool's face with x ≈ 0, so it
+    // goes without (docs/decisions.md, "Contact inside the solver", fourth session).
+    if (params.response == ContactResponse::kAfterStep) params.contact_onset_ramp_s = 0.0;
     NodeBoundsSolver* solver = world_->node_bounds_solver();
     if (params.response == ContactResponse::kInSolver && solver == nullptr)
       throw std::invalid_argument("contact_response = \"in_solver\" needs the instrumented soft-body solver (HostSimulationOptions::solver_node_bounds)");
