@@ -75,12 +75,9 @@ ClampReleaseResult run_clamp_release(const SceneDescription& clamp_scene, SceneC
 }
 
 SceneDescription clamp_cell_scene(ContactResponse response, bool tool_friction) {
-  SceneDescription scene = load_scene(resolve_scene_path("clamp-sphere"));
+  // The in-solver sweep cells' bed and friction (in_solver_plunge_scene), for either response.
+  SceneDescription scene = in_solver_plunge_scene(load_scene(resolve_scene_path("clamp-sphere")), tool_friction && response == ContactResponse::kInSolver);
   scene.simulation.contact_response = response;
-  if (response != ContactResponse::kInSolver || !tool_friction) {
-    scene.tool.friction_static_ratio = 0.0;
-    scene.tool.friction_kinetic_ratio = 0.0;
-  }
   return scene;
 }
 

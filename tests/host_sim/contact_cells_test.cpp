@@ -56,7 +56,7 @@ TEST(LeverCell, DISABLED_NoCutTriangleAndAQuietHold) {
 // The clamp squeezes the ball and opens along clamp-sphere's script: once the jaws are fully open
 // (gap 0.12 m > the ball's 0.10 m) nothing may hold on to them, after every settling time of issue
 // 22's clamp cell, with the after_step response too (frictionless jaws: it has no friction), the
-// ball on its bed as clamp-sphere ships it. On a free ball this response does not let go after 0.1,
+// ball on its bed (host::clamp_cell_scene). On a free ball (clamp-sphere as shipped) this response does not let go after 0.1,
 // 0.2 and 0.5 s (9.98 / 9.59 / 11.59 N open, docs/decisions.md): the squeezed ball bulges under jaw
 // A's tip, a soft node goes round the tip onto the jaw's outer face and is carried outwards as the
 // jaw opens. The bed holds the ball's bottom, so it neither bulges under the tip nor rolls.
@@ -76,7 +76,7 @@ TEST(ClampReleaseCell, OpeningReleasesTheBeddedBallAfterAnySettlingTime) {
 // In-solver response (issue 22, contact_response = "in_solver"): the levering blade (the in-solver
 // cells' scene, host::in_solver_plunge_scene) on the paper's 128-face ball and on a 1280-face one
 // keeps the paired guarantees, cuts no soft triangle on any step and holds the turned blade with
-// ≤ 1 % jitter; the opened clamp (clamp-sphere as shipped, and with frictionless jaws) lets go
+// ≤ 1 % jitter; the opened clamp (the clamp cell's bedded ball, with and without jaw friction) lets go
 // after every settling time, cutting none either.
 
 TEST(LeverCell, InSolverCrossesNoNodeCutsNoTriangleAndKeepsContactThroughTheTurn) {

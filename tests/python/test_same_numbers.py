@@ -22,8 +22,8 @@ def _hex_rows(rows):
     return [[float.fromhex(v) for v in row] for row in rows]
 
 
-# clamp-sphere and clamp-vessel-lift: the in-solver response with tool friction (by step 1800 the
-# vessel-lift jaws grip and lift).
+# clamp-vessel-lift: the in-solver response with tool friction (by step 1800 the
+# jaws grip and lift).
 @pytest.mark.parametrize("scene_name,method,steps", [("spatula-sphere", "paired", 450), ("clamp-sphere", "paired", 1300),
                                                      ("spatula-sphere", "bullet", 500), ("clamp-vessel-lift", "paired", 1800)])
 def test_host_steps_bit_for_bit(host_reference, scene_name, method, steps):

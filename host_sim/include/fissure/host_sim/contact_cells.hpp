@@ -57,9 +57,10 @@ struct ClampReleaseResult : CellStepCounts {
 
 [[nodiscard]] ClampReleaseResult run_clamp_release(const SceneDescription& clamp_scene, SceneCollisionMethod method, double settle_s);
 
-/// The clamp cell's scene: the shipped clamp-sphere (the ball on its bed, jaw friction 0.5 / 0.4,
-/// the in-solver response) with `response` in its place. Friction acts only inside the solver, so
-/// the after_step response and an in-solver run without `tool_friction` get frictionless jaws.
+/// The clamp cell's scene: clamp-sphere with its ball's bottom tied to a bed and jaw friction
+/// 0.5 / 0.4, as the in-solver sweep cells (in_solver_plunge_scene), and `response`. Friction acts
+/// only inside the solver, so after_step and an in-solver run without `tool_friction` get
+/// frictionless jaws. The shipped scene keeps its free ball (docs/decisions.md says why).
 [[nodiscard]] SceneDescription clamp_cell_scene(ContactResponse response, bool tool_friction);
 
 }  // namespace fissure::host
