@@ -325,6 +325,13 @@ TEST(ProxyBuilder, BuildDoesNotAllocate) {
 
 class PaperSceneProxy : public ::testing::TestWithParam<std::string> {};
 
+// The host's in-solver friction on the tool, summed over its parts (zero without friction).
+Eigen::Vector3d host_friction_n(const HostStepResult& step) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (int p = 0; p < step.part_count; ++p) sum += step.part_results[static_cast<std::size_t>(p)].friction_force_on_tool_world_n;
+  return sum;
+}
+
 TEST_P(PaperSceneProxy, RtEvaluationAtTheHostPoseIsWithinOnePercentOfTheHostForce) {
   const SceneDescription scene = load_scene(resolve_scene_path(GetParam()));
   HostSimulation sim(scene);
@@ -371,9 +378,7 @@ TEST_P(PaperSceneProxy, RtEvaluationAtTheHostPoseIsWithinOnePercentOfTheHostForc
       const Eigen::Vector3d rt_part = forces.force_world_n[static_cast<std::size_t>(model.part_of_jaw[j])];
       if (clamp) expect_within_one_percent(rt_part, host_part, GetParam() + " jaw " + std::to_string(jaw) + " t=" + std::to_string(t));
     }
-    Eigen::Vector3d host_friction = Eigen::Vector3d::Zero();
-    for (int p = 0; p < step.part_count; ++p) host_friction += step.part_results[static_cast<std::size_t>(p)].friction_force_on_tool_world_n;
-    EXPECT_LE((host_total + host_friction - step.force_on_tool_world_n).norm(), 1e-9 * (1.0 + host_total.norm()));
+    EXPECT_LE((host_total + host_friction_n(step) - step.force_on_tool_world_n).norm(), 1e-9 * (1.0 + host_total.norm()));
     expect_within_one_percent(forces.force_world_n[0] + forces.force_world_n[1] + forces.force_world_n[2], host_total,
                               GetParam() + " t=" + std::to_string(t));
     if (step.contact_count > 0) ++steps_in_contact;
@@ -440,9 +445,7 @@ HeldProxyError held_proxy_error(const std::string& scene_name, int steps_per_pro
     rt::take_latest_proxy(*exchange, *state, now_ns);
     if (state->have_proxy) {
       // The normal law only, as above: in-solver friction goes to rt_core's friction cone.
-      Eigen::Vector3d host_normal = step.force_on_tool_world_n;
-      for (int p = 0; p < step.part_count; ++p) host_normal -= step.part_results[static_cast<std::size_t>(p)].friction_force_on_tool_world_n;
-      const Eigen::Vector3d error = rt.total(rt::active_proxy(*state)) - host_normal;
+      const Eigen::Vector3d error = rt.total(rt::active_proxy(*state)) - (step.force_on_tool_world_n - host_friction_n(step));
       sum_sq += error.squaredNorm();
       ++compared;
     }
