@@ -17,6 +17,7 @@ void register_bench_collision(CommandTree& tree) {
     std::string json_path;
     std::string contact_response = "after_step";
     std::string in_solver_friction = "on";
+    std::string soft_model = "shell";
     eval::BenchCollisionOptions bench;
   };
   auto a = std::make_shared<Arguments>();
@@ -34,7 +35,13 @@ void register_bench_collision(CommandTree& tree) {
                   "In-solver plunge and levering cells: the tool's faces have friction 0.5 / 0.4 (on) or none (off)")
       ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
+  cmd->add_option("--soft-model", a->soft_model,
+                  "Sweep and levering cells' ball: shell (the paper's edge-link shell) or fem (the same surface filled with tetrahedra, "
+                  "an FEM body on a bed; with --only sweep --only cells)")
+      ->check(CLI::IsMember({"shell", "fem"}))
+      ->capture_default_str();
   cmd->callback([a] {
+    a->bench.soft_model = a->soft_model == "fem" ? host::SoftBodyModel::kFem : host::SoftBodyModel::kShell;
     a->bench.in_solver_tool_friction = a->in_solver_friction == "on";
     a->bench.contact_response = *host::parse_contact_response(a->contact_response);  // IsMember checked the name
     write_json_file(a->json_path, eval::run_bench_collision(a->bench));

@@ -138,6 +138,12 @@ SceneDescription sphere_scene(int faces, bool icosphere, host::ContactResponse r
   return s;
 }
 
+// A sweep or levering cell's scene: the shell cell (plunge_cell_scene) or its volumetric ball.
+SceneDescription cell_scene(const host::PlungeTool& tool, int icosphere_faces, const BenchCollisionOptions& o) {
+  if (o.soft_model == host::SoftBodyModel::kFem) return host::volumetric_plunge_scene(host::plunge_scene(tool, icosphere_faces), icosphere_faces);
+  return host::plunge_cell_scene(tool, icosphere_faces, o.contact_response, o.in_solver_tool_friction);
+}
+
 // ---- 1. Tunnelling sweep: speed × tool × method, on the 128-face ball and (paired) on a 1280-face icosphere.
 void print_sweep_legend(double hold_s) {
   std::printf("(hold: |F| every step for %.1f s after a %.0f ms settling window, fitted by a line; in %% of the mean force:\n"
@@ -151,13 +157,13 @@ void print_sweep_legend(double hold_s) {
 
 // One sweep table: every tool × method × speed on the ball of `icosphere_faces` (0: the paper's 128-face shell).
 nlohmann::json sweep_cells(const std::vector<double>& speeds, const std::vector<SceneCollisionMethod>& methods, int icosphere_faces, double hold_s,
-                           host::ContactResponse response, bool tool_friction, const char* progress_name) {
+                           const BenchCollisionOptions& o, const char* progress_name) {
   const auto& tools = host::plunge_tools();
   nlohmann::json sweep = nlohmann::json::array();
   SimProgress progress(progress_name, static_cast<long>(speeds.size() * tools.size() * methods.size()));
   long done = 0;
   for (const host::PlungeTool& tool : tools) {
-    const SceneDescription scene = host::plunge_cell_scene(tool, icosphere_faces, response, tool_friction);
+    const SceneDescription scene = cell_scene(tool, icosphere_faces, o);
     const std::string tool_name(tool.name);
     for (SceneCollisionMethod method : methods) {
       for (double v : speeds) {
@@ -194,20 +200,29 @@ nlohmann::json sweep_cells(const std::vector<double>& speeds, const std::vector<
 void run_sweep(const BenchCollisionOptions& o, nlohmann::json& out) {
   const std::vector<double> speeds = o.quick ? std::vector<double>{0.1, 10.0, 50.0} : std::vector<double>{0.1, 0.5, 1, 2, 5, 10, 20, 50};
   const double hold_s = o.quick ? 0.1 : 0.5;
-  std::printf("\n1. Tunnelling sweep (sphere 128 faces with pose matching kMT %.2f, 1 kHz, plunge %.0f mm, hold %.1f s)\n", kShapeMatchingRatio,
-              host::kPlungeDepth_m * 1e3, hold_s);
+  const bool fem = o.soft_model == host::SoftBodyModel::kFem;
+  if (fem) {
+    std::printf("\n1. Tunnelling sweep on the volumetric ball (the 128-face surface filled with tetrahedra, FEM E %.0f kPa, on its bed, after_step;"
+                " 1 kHz, plunge %.0f mm, hold %.1f s)\n", host::kPlungeFemYoungsModulus_pa * 1e-3, host::kPlungeDepth_m * 1e3, hold_s);
+  } else {
+    std::printf("\n1. Tunnelling sweep (sphere 128 faces with pose matching kMT %.2f, 1 kHz, plunge %.0f mm, hold %.1f s)\n", kShapeMatchingRatio,
+                host::kPlungeDepth_m * 1e3, hold_s);
+  }
   out["sweep_body"] = {{"faces", 128}, {"shape_matching_ratio", kShapeMatchingRatio}, {"plunge_depth_m", host::kPlungeDepth_m}, {"hold_s", hold_s},
                        {"hold_settle_s", host::kHoldSettle_s}};
   print_sweep_legend(hold_s);
-  out["sweep"] = sweep_cells(speeds, {SceneCollisionMethod::kBullet, SceneCollisionMethod::kRay, SceneCollisionMethod::kPaired}, 0, hold_s,
-                             o.contact_response, o.in_solver_tool_friction, "bench collision: sweep");
+  if (fem) out["sweep_body"]["youngs_modulus_pa"] = host::kPlungeFemYoungsModulus_pa;
+  // Bullet's method and the ray method act on the classic soft body only.
+  const std::vector<SceneCollisionMethod> methods =
+      fem ? std::vector<SceneCollisionMethod>{SceneCollisionMethod::kPaired}
+          : std::vector<SceneCollisionMethod>{SceneCollisionMethod::kBullet, SceneCollisionMethod::kRay, SceneCollisionMethod::kPaired};
+  out["sweep"] = sweep_cells(speeds, methods, 0, hold_s, o, "bench collision: sweep");
   std::printf("\n1b. The same paired cells on a %d-face icosphere (issue 22's second mesh)\n", kFineSweepFaces);
   out["sweep_fine_body"] = {{"faces", kFineSweepFaces}, {"tessellation", "icosphere"}, {"shape_matching_ratio", kShapeMatchingRatio},
                             {"plunge_depth_m", host::kPlungeDepth_m}, {"hold_s", hold_s}, {"hold_settle_s", host::kHoldSettle_s}};
   print_sweep_legend(hold_s);
   out["sweep_fine"] =
-      sweep_cells(speeds, {SceneCollisionMethod::kPaired}, kFineSweepFaces, hold_s, o.contact_response, o.in_solver_tool_friction,
-                  "bench collision: sweep, 1280 faces");
+      sweep_cells(speeds, {SceneCollisionMethod::kPaired}, kFineSweepFaces, hold_s, o, "bench collision: sweep, 1280 faces");
 }
 
 // ---- 1c. Levering and clamp-release cells (issue 22) -------------------------------------------
@@ -220,8 +235,11 @@ void run_motion_cells(const BenchCollisionOptions& o, nlohmann::json& out) {
               "F_hold N", "jitter%", "step%");
   nlohmann::json lever = nlohmann::json::array();
   for (const int faces : {0, kFineSweepFaces}) {
-    const SceneDescription scene = host::plunge_cell_scene(host::plunge_tools()[2], faces, o.contact_response, o.in_solver_tool_friction);
-    for (SceneCollisionMethod method : {SceneCollisionMethod::kBullet, SceneCollisionMethod::kPaired}) {
+    const SceneDescription scene = cell_scene(host::plunge_tools()[2], faces, o);
+    const std::vector<SceneCollisionMethod> methods = o.soft_model == host::SoftBodyModel::kFem
+                                                          ? std::vector<SceneCollisionMethod>{SceneCollisionMethod::kPaired}
+                                                          : std::vector<SceneCollisionMethod>{SceneCollisionMethod::kBullet, SceneCollisionMethod::kPaired};
+    for (SceneCollisionMethod method : methods) {
       const host::LeverResult r = host::run_lever_hold(scene, method, hold_s);
       const int mesh = faces == 0 ? 128 : faces;
       std::printf("%-8d %-7s | %7d %7d %9.3f | %9d %8d %8d %9.3f | %9.3f %9.3f\n", mesh, host::to_string(method), r.crossed_nodes, r.inside_nodes,
@@ -236,6 +254,10 @@ void run_motion_cells(const BenchCollisionOptions& o, nlohmann::json& out) {
     }
   }
   out["lever"] = lever;
+  if (o.soft_model == host::SoftBodyModel::kFem) {
+    std::printf("\n1d. Clamp release: not run on the volumetric ball (the clamp cell's ball is clamp-sphere's shell)\n");
+    return;
+  }
 
   const SceneDescription clamp = host::clamp_cell_scene(o.contact_response, o.in_solver_tool_friction);
   std::printf("\n1d. Clamp release: clamp-sphere's script (close, hold, open fully) after settling; the larger jaw's |F| from the %dth fully open step\n",
@@ -507,6 +529,9 @@ nlohmann::json run_parts(const BenchCollisionOptions& o) {
   out["load_average_start"] = load_average();
   out["contact_response"] = host::to_string(o.contact_response);
   out["in_solver_tool_friction"] = o.in_solver_tool_friction;
+  out["soft_model"] = o.soft_model == host::SoftBodyModel::kFem ? "fem" : "shell";
+  if (o.soft_model == host::SoftBodyModel::kFem && (o.runs("indentation") || o.runs("scaling")))
+    throw EvalError("bench collision: the volumetric ball (--soft-model fem) runs the sweep and cells parts only: add --only sweep --only cells");
   const SceneDescription base = with_response(base_scene(), o.contact_response);
   if (o.runs("sweep")) {
     run_sweep(o, out);

@@ -174,6 +174,16 @@ void add_device_input_cases(std::vector<StressCase>& cases) {
                    [](StressSetup& s, std::uint64_t seed) { random_hand(s, HandStyle::kFlicks, seed); }});
   cases.push_back({"hand_vibration_tick_rate", g, scene, 1000.0,
                    [](StressSetup& s, std::uint64_t seed) { random_hand(s, HandStyle::kVibration, seed); }});
+  // The same hands on the in-solver response (convex-spatula-sphere: the same ball and mapping,
+  // tied to its bed, the tool's friction on): its contact onset ramp and its friction are what
+  // the hand feels there, and their energy is bounded the same way.
+  const std::string in_solver_scene = "convex-spatula-sphere";
+  cases.push_back({"in_solver_hand_random", g, in_solver_scene, 1000.0,
+                   [](StressSetup& s, std::uint64_t seed) { random_hand(s, HandStyle::kRandom, seed); }});
+  cases.push_back({"in_solver_hand_teleports", g, in_solver_scene, 1000.0,
+                   [](StressSetup& s, std::uint64_t seed) { random_hand(s, HandStyle::kTeleports, seed); }});
+  cases.push_back({"in_solver_hand_flicks_10m_per_s", g, in_solver_scene, 1000.0,
+                   [](StressSetup& s, std::uint64_t seed) { random_hand(s, HandStyle::kFlicks, seed); }});
   cases.push_back({"encoder_stuck", g, scene, 1000.0, [](StressSetup& s, std::uint64_t seed) {
                      random_hand(s, HandStyle::kRandom, seed);
                      s.fault_windows = periodic_windows(s.duration_s);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <stdexcept>
 #include <string>
 #include <variant>
@@ -9,6 +10,7 @@
 #include "fissure/host_sim/host_simulation.hpp"
 #include "fissure/host_sim/scene_loader.hpp"
 #include "fissure/host_sim/soft_body_builder.hpp"
+#include "fissure/host_sim/tet_mesh_checks.hpp"
 
 namespace fissure::host {
 
@@ -48,6 +50,40 @@ SceneDescription plunge_cell_scene(const PlungeTool& tool, int icosphere_faces, 
   SceneDescription scene = plunge_scene(tool, icosphere_faces);
   if (response == ContactResponse::kInSolver) return in_solver_plunge_scene(scene, tool_friction);
   scene.simulation.contact_response = response;
+  return scene;
+}
+
+SceneDescription volumetric_plunge_scene(SceneDescription scene, int icosphere_faces) {
+  if (icosphere_faces != 0 && icosphere_faces != 1280)
+    throw std::invalid_argument("the volumetric sweep ball is the 128-face shell's (icosphere_faces 0) or the 1280-face icosphere's, got " +
+                                std::to_string(icosphere_faces));
+  const std::string file = icosphere_faces == 0 ? "plunge-ball-128.1.node" : "plunge-ball-1280.1.node";
+  const std::filesystem::path path = find_scenes_dir() / "meshes" / file;
+  VolumeMesh volume = read_soft_body_tet_mesh(path.string());
+  SoftBodyDescription soft;
+  SoftMesh mesh;
+  mesh.mesh_path = path.lexically_normal().string();
+  mesh.vertices_world_m = std::move(volume.vertices_m);
+  mesh.triangles = std::move(volume.boundary_triangles);
+  mesh.tetrahedra = std::move(volume.tetrahedra);
+  soft.model = SoftBodyModel::kFem;
+  soft.fem.model = FemModel::kCorotatedSmoothed;
+  soft.fem.youngs_modulus_pa = kPlungeFemYoungsModulus_pa;
+  soft.fem.poisson_ratio = kTissuePoissonRatio;
+  soft.fem.density_kg_per_m3 = kTissueDensityKgPerM3;
+  soft.fem.mass_damping_per_s = kPlungeFemMassDamping_per_s;
+  soft.mass_kg = soft.fem.density_kg_per_m3 * tet_mesh_volume_m3(TetMesh{"", mesh.vertices_world_m, mesh.tetrahedra, {}, 0});
+  soft.shape = std::move(mesh);
+  const SoftBodyDescription& shell = scene.soft_bodies.front();
+  soft.friction_ratio = shell.friction_ratio;
+  soft.collision_margin_m = shell.collision_margin_m;
+  SoftAnchorBox bed;
+  bed.min_world_m = {-1.0, scene.ground.top_height_m - 1.0, -1.0};
+  bed.max_world_m = {1.0, scene.ground.top_height_m + kPlungeBedTop_m, 1.0};
+  soft.anchors.push_back(bed);
+  scene.soft_bodies = {std::move(soft)};
+  scene.simulation.contact_response = ContactResponse::kAfterStep;
+  scene.tool.friction_static_ratio = scene.tool.friction_kinetic_ratio = 0.0;
   return scene;
 }
 

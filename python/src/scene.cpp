@@ -52,9 +52,17 @@ const host::PlungeTool& plunge_tool_named(const std::string& name) {
 }
 
 // The sweep's cell scene (host::plunge_cell_scene) for a response named as in scene files.
-SceneDescription plunge_cell_scene(const host::PlungeTool& tool, const std::string& contact_response, bool tool_friction, int icosphere_faces) {
+// soft_model "fem": the volumetric sweep ball (host::volumetric_plunge_scene; after_step only).
+SceneDescription plunge_cell_scene(const host::PlungeTool& tool, const std::string& contact_response, bool tool_friction, int icosphere_faces,
+                                   const std::string& soft_model) {
   const std::optional<host::ContactResponse> response = host::parse_contact_response(contact_response);
   if (!response) throw std::invalid_argument("contact_response '" + contact_response + "' is not one of: after_step, in_solver");
+  if (soft_model == "fem") {
+    if (*response != host::ContactResponse::kAfterStep)
+      throw std::invalid_argument("soft_model 'fem': the volumetric ball takes contact_response 'after_step'");
+    return host::volumetric_plunge_scene(host::plunge_scene(tool, icosphere_faces), icosphere_faces);
+  }
+  if (soft_model != "shell") throw std::invalid_argument("soft_model '" + soft_model + "' is not one of: shell, fem");
   return host::plunge_cell_scene(tool, icosphere_faces, *response, tool_friction);
 }
 
@@ -215,19 +223,21 @@ void bind_scene(py::module_& m) {
       "box_size_m (3,) [m], orientation_rpy_deg (3,), leading_half_m (tool origin to its lowest point) [m].");
   m.def(
       "plunge_scene",
-      [](const std::string& tool, const std::string& contact_response, bool tool_friction, int icosphere_faces) {
-        return plunge_cell_scene(plunge_tool_named(tool), contact_response, tool_friction, icosphere_faces);
+      [](const std::string& tool, const std::string& contact_response, bool tool_friction, int icosphere_faces, const std::string& soft_model) {
+        return plunge_cell_scene(plunge_tool_named(tool), contact_response, tool_friction, icosphere_faces, soft_model);
       },
       py::arg("tool"), py::arg("contact_response") = "after_step", py::arg("tool_friction") = true, py::arg("icosphere_faces") = 0,
+      py::arg("soft_model") = "shell",
       "spatula-sphere with the named plunge tool and the plunge ball's pose matching (the sweep's scene); contact_response\n"
       "'in_solver' gives the bench's in-solver cell (the ball's bed anchored; tool_friction: the plunge's Coulomb friction\n"
-      "with the default viscous shear); icosphere_faces: an icosphere ball instead (1280: the sweep's fine ball).");
+      "with the default viscous shear); icosphere_faces: an icosphere ball instead (1280: the sweep's fine ball);\n"
+      "soft_model 'fem': the same surface filled with tetrahedra, an FEM body on the bed (after_step).");
   m.def(
       "run_plunge_hold",
       [](const std::string& tool_name, const std::string& method, double speed_m_s, double hold_s, bool count_cut_triangles,
-         const std::string& contact_response, bool tool_friction, int icosphere_faces) {
+         const std::string& contact_response, bool tool_friction, int icosphere_faces, const std::string& soft_model) {
         const host::PlungeTool& tool = plunge_tool_named(tool_name);
-        const SceneDescription scene = plunge_cell_scene(tool, contact_response, tool_friction, icosphere_faces);
+        const SceneDescription scene = plunge_cell_scene(tool, contact_response, tool_friction, icosphere_faces, soft_model);
         const host::SceneCollisionMethod parsed = parse_method(method);
         host::PlungeHoldResult r;
         {
@@ -259,6 +269,7 @@ void bind_scene(py::module_& m) {
       },
       py::arg("tool"), py::arg("method"), py::arg("speed_m_s"), py::arg("hold_s") = 0.5, py::arg("count_cut_triangles") = false,
       py::arg("contact_response") = "after_step", py::arg("tool_friction") = true, py::arg("icosphere_faces") = 0,
+      py::arg("soft_model") = "shell",
       "One cell of the tunnelling sweep (the function `fissure bench collision` runs): settle the plunge ball,\n"
       "drive `tool` (a plunge_tools() name) 20 mm into it at speed_m_s [m/s] with `method` ('paired', 'ray',\n"
       "'bullet'), hold hold_s [s] after a 50 ms settling window. Lockstep: every figure but step_s is deterministic.\n"
@@ -266,7 +277,8 @@ void bind_scene(py::module_& m) {
       "step, (H,) [N]), step_s (wall time per step, (S,) [s]), the hold statistics (fractions of the mean force)\n"
       "and, with count_cut_triangles, the soft triangles cut by the tool during the hold (-1 otherwise).\n"
       "contact_response 'in_solver' runs the bench's in-solver cell (the ball's bed anchored; tool_friction: the\n"
-      "plunge's Coulomb friction with the default viscous shear); icosphere_faces: an icosphere ball instead (1280: the sweep's fine ball).");
+      "plunge's Coulomb friction with the default viscous shear); icosphere_faces: an icosphere ball instead (1280: the sweep's fine ball);\n"
+      "soft_model 'fem': the volumetric ball (plunge_scene).");
 }
 
 }  // namespace fissure::python

@@ -7,16 +7,21 @@
 #include <BulletSoftBody/btSoftBody.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <stdexcept>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "fcl_oracle.hpp"
 #include "fissure/host_sim/contact_metrics.hpp"
+#include "fissure/host_sim/fem_material.hpp"
 #include "fissure/host_sim/host_simulation.hpp"
 #include "fissure/host_sim/plunge_hold.hpp"
+#include "fissure/host_sim/soft_body_builder.hpp"
 #include "fissure/host_sim/soft_world.hpp"
 
 namespace fissure::host {
@@ -175,6 +180,47 @@ TEST(InSolverHold, TheFineBallsBladeIsQuietAfterAFastPlunge) {
     EXPECT_GT(c.hold.mean_n, 0.0) << speed << " m/s";
     EXPECT_LE(c.hold.jitter, kMaxHoldJitter) << speed << " m/s";
   }
+}
+
+// The volumetric sweep ball (volumetric_plunge_scene, `fissure bench collision --soft-model fem`):
+// the shell's own surface, vertex for vertex, filled with tetrahedra — an FEM body on the bed.
+TEST(VolumetricSweepBall, IsTheShellsOwnSurfaceFilledWithTetrahedra) {
+  for (const int faces : {0, 1280}) {
+    const SceneDescription shell = plunge_scene(plunge_tools()[0], faces);
+    const SceneDescription fem = volumetric_plunge_scene(shell, faces);
+    ASSERT_EQ(fem.soft_bodies.size(), 1U);
+    const SoftBodyDescription& body = fem.soft_bodies.front();
+    EXPECT_EQ(body.model, SoftBodyModel::kFem);
+    EXPECT_EQ(body.fem.youngs_modulus_pa, kPlungeFemYoungsModulus_pa);
+    EXPECT_EQ(fem.simulation.contact_response, ContactResponse::kAfterStep);
+    EXPECT_EQ(body.anchors.size(), 1U) << "the bed";
+    const auto& mesh = std::get<SoftMesh>(body.shape);
+    EXPECT_EQ(mesh.triangles.size(), faces == 0 ? 128U : 1280U) << faces;
+    EXPECT_GT(mesh.tetrahedra.size(), mesh.triangles.size()) << faces;
+    // TetGen -Y keeps the surface's points, in their order, as the mesh's first vertices.
+    const std::vector<Vec3> rest = soft_body_rest(shell.soft_bodies.front()).nodes_world_m;
+    ASSERT_GT(mesh.vertices_world_m.size(), rest.size()) << "interior nodes too";
+    double worst_m = 0.0;
+    for (std::size_t i = 0; i < rest.size(); ++i) {
+      for (std::size_t k = 0; k < 3; ++k) worst_m = std::max(worst_m, std::abs(mesh.vertices_world_m[i][k] - rest[i][k]));
+    }
+    EXPECT_LE(worst_m, 1e-15) << faces;
+    // Its mass is the tissue's density times its volume: a little under the 50 mm sphere's.
+    const double sphere_kg = kTissueDensityKgPerM3 * 4.0 / 3.0 * 3.141592653589793 * 0.05 * 0.05 * 0.05;
+    EXPECT_GT(body.mass_kg, 0.85 * sphere_kg) << faces;
+    EXPECT_LT(body.mass_kg, sphere_kg) << faces;
+  }
+  EXPECT_THROW((void)volumetric_plunge_scene(plunge_scene(plunge_tools()[0], 320), 320), std::invalid_argument);
+}
+
+TEST(VolumetricSweepBall, APlatePlungedAndHeldCrossesNoNode) {
+  const PlungeTool& plate = plunge_tools()[0];
+  const SceneDescription fem = volumetric_plunge_scene(plunge_scene(plate, 0), 0);
+  const PlungeHoldResult r = run_plunge_hold(fem, SceneCollisionMethod::kPaired, 1.0, plate.leading_half_m, 0.1, /*count_cut_triangles=*/true);
+  EXPECT_EQ(r.crossed_nodes, 0);
+  EXPECT_LE(r.max_penetration_m, kMaxPenetrationM);
+  EXPECT_TRUE(r.hold.in_contact);
+  EXPECT_GT(r.hold.mean_n, 1.0) << "20 mm into a 20 kPa ball";
 }
 
 }  // namespace

@@ -19,6 +19,10 @@ struct BenchCollisionOptions {
   host::ContactResponse contact_response = host::ContactResponse::kAfterStep;
   /// In-solver plunge and levering cells: the tool's faces have friction 0.5 / 0.4 (true) or none.
   bool in_solver_tool_friction = true;
+  /// The sweep and levering cells' ball: the paper's shell (kShell) or the same surface filled
+  /// with tetrahedra, an FEM body (kFem: host::volumetric_plunge_scene, after_step; the sweep,
+  /// levering only — Bullet's method and the clamp cell's ball are shells).
+  host::SoftBodyModel soft_model = host::SoftBodyModel::kShell;
   [[nodiscard]] bool runs(const char* part) const;
 };
 

@@ -78,6 +78,24 @@ inline constexpr double kPlungeBedTop_m = 0.015;
 /// `response`; in_solver through in_solver_plunge_scene (friction unless switched off, the bed).
 [[nodiscard]] SceneDescription plunge_cell_scene(const PlungeTool& tool, int icosphere_faces, ContactResponse response, bool tool_friction);
 
+/// The volumetric sweep ball (`fissure bench collision --soft-model fem`): the shell's own
+/// surface (the 128-face ball, or the 1280-face icosphere), vertex for vertex, filled with
+/// tetrahedra by TetGen keeping that surface (tools/plunge_ball_surface.py gives the command;
+/// scenes/meshes/plunge-ball-128.1.node: 81 nodes, 244 tetrahedra; plunge-ball-1280.1.node: 1,006
+/// nodes, 4,015 tetrahedra), an FEM body in Bullet's deformable world on the in-solver cells' bed.
+/// It asks whether what the shell cells miss (hold jitter after the shell's own settling,
+/// docs/decisions.md) is the shell's: an elastic volume has a restoring force everywhere.
+/// E 20 kPa: the box spatula's 1 cm press of spatula-sphere then holds 6.01 N on this ball, the
+/// shell's 5.96 N (`fissure sim` on the scene with this body); within soft tissue's 1–100 kPa
+/// (brain 1–3, liver 5–10, muscle 10–100 kPa; fem_material.hpp has the sources).
+inline constexpr double kPlungeFemYoungsModulus_pa = 20000.0;
+/// Mass damping [1/s]: spatula-fem-lobe's, which settles a body on its bed within ~0.3 s.
+inline constexpr double kPlungeFemMassDamping_per_s = 10.0;
+/// `scene` (a plunge scene) with the volumetric ball of `icosphere_faces` faces (0: 128, or 1280)
+/// on the bed; after_step (the FEM body's contact response). Throws std::invalid_argument for
+/// another face count, MeshError when the shipped mesh cannot be read.
+[[nodiscard]] SceneDescription volumetric_plunge_scene(SceneDescription scene, int icosphere_faces);
+
 /// Where a plunge starts: the tool kPlungeStartClearance_m above the settled soft surface, and
 /// the height of its origin once the leading face is kPlungeDepth_m below that surface [m, world y].
 struct PlungeStart {
