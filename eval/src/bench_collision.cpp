@@ -148,7 +148,8 @@ SceneDescription cell_scene(const host::PlungeTool& tool, int icosphere_faces, c
 void print_sweep_legend(double hold_s) {
   std::printf("(hold: |F| every step for %.1f s after a %.0f ms settling window, fitted by a line; in %% of the mean force:\n"
               " jitter = residual std about the line, std = plain std, step = std of the step-to-step change / sqrt 2,\n"
-              " drift = the line's change over the hold (the soft body relaxing); 'lost' = no contact left in the hold)\n", hold_s, host::kHoldSettle_s * 1e3);
+              " drift = the line's change over the hold (the soft body relaxing); 'lost' = no contact left in the hold;\n"
+              " 'NONFINITE' = the soft body went non-finite, the cell stopped there with every node counted crossed)\n", hold_s, host::kHoldSettle_s * 1e3);
   std::printf(" cut = soft triangles reaching > %.1f mm into the tool during the hold, most on a step / steps with any (nodes may all be outside))\n",
               host::kInsideToleranceM * 1e3);
   std::printf("%-17s %-7s %7s | %7s %7s %7s | %9s %8s %8s %8s %8s %9s %9s %9s\n", "tool", "method", "v m/s", "crossed", "wrong", "inside", "pen mm",
@@ -172,7 +173,9 @@ nlohmann::json sweep_cells(const std::vector<double>& speeds, const std::vector<
         const double median_us = sim_quantile(c.step_s, 0.5) * 1e6;
         const double p99_us = sim_quantile(c.step_s, 0.99) * 1e6;
         progress.update(++done, tool_name + " " + host::to_string(method));
-        char jitter[16] = "lost", drift[16] = "lost", std_over_mean[16] = "lost", step_noise[16] = "lost";
+        const char* no_hold = c.non_finite ? "NONFINITE" : "lost";
+        char jitter[16], drift[16], std_over_mean[16], step_noise[16];
+        for (char* field : {jitter, drift, std_over_mean, step_noise}) std::snprintf(field, 16, "%s", no_hold);
         if (h.in_contact) {
           std::snprintf(jitter, sizeof jitter, "%.3f", 100.0 * h.jitter);
           std::snprintf(std_over_mean, sizeof std_over_mean, "%.3f", 100.0 * h.std_over_mean);
@@ -189,7 +192,7 @@ nlohmann::json sweep_cells(const std::vector<double>& speeds, const std::vector<
                          {"force_step_noise", if_contact(h.step_noise)}, {"force_drift", if_contact(h.drift)}, {"hold_in_contact", h.in_contact},
                          {"hold_settle_s", host::kHoldSettle_s}, {"hold_force_n", h.mean_n}, {"step_median_us", median_us}, {"step_p99_us", p99_us},
                          {"hold_steps", c.hold_force_n.size()}, {"hold_max_cut_triangles", c.hold_max_cut_triangles},
-                         {"hold_steps_with_cut_triangles", c.hold_steps_with_cut_triangles}});
+                         {"hold_steps_with_cut_triangles", c.hold_steps_with_cut_triangles}, {"non_finite", c.non_finite}});
       }
     }
   }

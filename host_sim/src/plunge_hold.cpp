@@ -177,9 +177,23 @@ PlungeHoldResult run_plunge_hold(const SceneDescription& scene, SceneCollisionMe
     for (int p = 0; p < r.part_count; ++p) count += r.part_results[static_cast<std::size_t>(p)].contacted_triangles;
     return count;
   };
+  auto body_finite = [&sim] {
+    for (const Eigen::Vector3d& p : sim.node_positions_world_m()) {
+      if (!p.allFinite()) return false;
+    }
+    return true;
+  };
+  auto stop_non_finite = [&] {
+    result.non_finite = true;
+    result.crossed_nodes = result.inside_nodes = static_cast<int>(sim.node_positions_world_m().size());
+    result.hold_force_n.clear();
+    result.hold = hold_force_stats(result.hold_force_n);
+    return result;
+  };
   while (pose.position_world_m.y() > end_y) {
     pose.position_world_m.y() = std::max(end_y, pose.position_world_m.y() - speed_m_s * dt);
     record(sim.step(pose));
+    if (!body_finite()) return stop_non_finite();
   }
   const long settle_steps = std::lround(kHoldSettle_s / dt);
   const long hold_steps = std::lround(hold_s / dt);
@@ -189,6 +203,7 @@ PlungeHoldResult run_plunge_hold(const SceneDescription& scene, SceneCollisionMe
   for (long i = 0; i < settle_steps + hold_steps; ++i) {
     const HostStepResult& r = sim.step(pose);
     record(r);
+    if (!body_finite()) return stop_non_finite();
     if (i < settle_steps) continue;
     result.hold_force_n.push_back(r.force_on_tool_world_n.norm());
     Eigen::Vector3d friction = Eigen::Vector3d::Zero();

@@ -257,6 +257,7 @@ void bind_scene(py::module_& m) {
         d["hold_max_cut_triangles"] = r.hold_max_cut_triangles;
         d["hold_steps_with_cut_triangles"] = r.hold_steps_with_cut_triangles;
         d["step_s"] = to_array(r.step_s);
+        d["non_finite"] = r.non_finite;
         py::dict hold;
         hold["in_contact"] = r.hold.in_contact;
         hold["mean_n"] = r.hold.mean_n;

@@ -133,6 +133,10 @@ struct PlungeHoldResult {
   int hold_steps_with_cut_triangles = -1; ///< hold steps with at least one
   std::vector<double> step_s;        ///< wall time of every step (plunge and hold)
   HoldForceStats hold;
+  /// The soft body went non-finite (an FEM body whose elements the plunge inverted): the cell
+  /// stops at that step, with every node counted crossed and the hold out of contact, instead of
+  /// stepping the garbage to the end (Bullet's corotation then spends seconds per step).
+  bool non_finite = false;
 };
 
 /// Called on every measured hold step with the simulation and that step's cut-triangle count
