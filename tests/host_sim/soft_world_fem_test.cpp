@@ -70,10 +70,11 @@ class FemHost : public ::testing::Test {
   std::string scene_text_;
 };
 
-// Plunge speeds 5 cm/s and 1 m/s, ending 6 mm deep. The contact holds the surface nodes only: a
-// press that crushes a 10 mm cell further lets its interior node pass the surface and reach the
-// tool (5 m/s ends 7.5 mm deep: 5 interior nodes in the tool during the hold; 10 m/s, 12.5 mm in
-// one step: 15 through it — docs/decisions.md, "Tissue (issue 24)").
+// Plunge speeds 5 cm/s to 10 m/s, ending 6 mm deep or, in 5 and 10 mm steps, the first step past
+// it (7.5 and 12.6 mm). The block's interior nodes are the contact's candidates as its surface
+// nodes are (broad_phase.cpp, take_faceless): without that, 5 interior nodes entered the tool
+// during the 5 m/s hold and 15 passed through it at 10 m/s, where one step crosses a whole cell
+// (docs/decisions.md, "Tissue (issue 24)").
 class FemHostPlunge : public FemHost, public ::testing::WithParamInterface<double> {};
 
 TEST_P(FemHostPlunge, TheSpatulaPressesTheFemBlockWithNoCrossedNodeAndAForceThatGrowsWithDepth) {
@@ -116,8 +117,10 @@ TEST_P(FemHostPlunge, TheSpatulaPressesTheFemBlockWithNoCrossedNodeAndAForceThat
   }
   EXPECT_EQ(crossed_max, 0);
   EXPECT_TRUE(finite);
-  EXPECT_GT(force_at_3mm, 0.0);           // the tissue pushes the tool up
-  EXPECT_GT(force_at_6mm, force_at_3mm);  // and harder the deeper it goes
+  EXPECT_GT(force_at_3mm, 0.0);  // the tissue pushes the tool up
+  if (speed_m_per_s * dt < 0.003) {
+    EXPECT_GT(force_at_6mm, force_at_3mm);  // and harder the deeper it goes (3 and 6 mm: one step above 3 mm a step)
+  }
   // Held there, the body does not creep through the tool, and the fixed underside stays put.
   double held_force_n = 0.0;
   for (int i = 0; i < 200; ++i) {
@@ -136,11 +139,11 @@ TEST_P(FemHostPlunge, TheSpatulaPressesTheFemBlockWithNoCrossedNodeAndAForceThat
   EXPECT_EQ(unmoved, fixed);
 }
 
-INSTANTIATE_TEST_SUITE_P(Speeds, FemHostPlunge, ::testing::Values(0.05, 1.0));
+INSTANTIATE_TEST_SUITE_P(Speeds, FemHostPlunge, ::testing::Values(0.05, 1.0, 5.0, 10.0));
 
 // The in-solver contact (contact_response = "in_solver"): one implicit step per 1 ms host step,
 // the contact projected after each of its Newton iterations (fem_world.cpp). Plunge speeds 5 cm/s
-// to 10 m/s, ending 6 mm deep, then held 0.2 s.
+// to 10 m/s as above (10 m/s: one 10 mm step through a 10 mm cell), then held 0.2 s.
 class FemHostInSolverPlunge : public FemHost, public ::testing::WithParamInterface<double> {};
 
 TEST_P(FemHostInSolverPlunge, TheImplicitStepHoldsTheContactWithNoCrossedNode) {
@@ -200,11 +203,13 @@ TEST_P(FemHostInSolverPlunge, TheImplicitStepHoldsTheContactWithNoCrossedNode) {
   if (speed_m_per_s * dt < 0.003) {
     EXPECT_GT(force_at_6mm, force_at_3mm);
   }
-  // The held force: within 0.5–1.5 N, and steady over the hold's last 0.1 s (measured: 0.2 % at
-  // 5 cm/s, 3.5 % at 1 m/s). At 5 m/s the plunge ends 7.5 mm deep in one 5 mm step and the body
-  // still rings with its mass damping (10 /s): 9 %.
-  EXPECT_GT(held_mean, 0.5);
-  EXPECT_LT(held_mean, 1.5);
+  // The held force: within 0.5–1.5 N at 6 mm, scaled as x^1.5 to the depth the plunge ended at
+  // (Hunt-Crossley's exponent), and steady over the hold's last 0.1 s (measured: 0.2 % at 5 cm/s,
+  // 3.5 % at 1 m/s, 3 % at 10 m/s). At 5 m/s the plunge ends 7.5 mm deep in one 5 mm step and the
+  // body still rings with its mass damping (10 /s): 9 %.
+  const double depth_scale = std::pow((top_m - (pose.position_world_m.y() - half_thickness_m)) / 0.006, 1.5);
+  EXPECT_GT(held_mean, 0.5 * depth_scale);
+  EXPECT_LT(held_mean, 1.5 * depth_scale);
   EXPECT_LT(held_std, (speed_m_per_s < 2.0 ? 0.05 : 0.15) * held_mean);
   int unmoved = 0;
   for (int i = 0; i < soft.m_nodes.size(); ++i) {
@@ -215,11 +220,7 @@ TEST_P(FemHostInSolverPlunge, TheImplicitStepHoldsTheContactWithNoCrossedNode) {
   EXPECT_EQ(unmoved, sim.world().anchored_nodes_count());
 }
 
-INSTANTIATE_TEST_SUITE_P(Speeds, FemHostInSolverPlunge, ::testing::Values(0.05, 1.0, 5.0));
-// 10 m/s (the tool 10 mm a step through 10 mm cells): 15 nodes pass through the tool — the
-// block's interior layer, which the surface contact does not hold (its candidates are the boundary
-// triangles' nodes), as after_step (docs/decisions.md, "Tissue (issue 24)"). The target, disabled.
-INSTANTIATE_TEST_SUITE_P(DISABLED_TenMetresPerSecond, FemHostInSolverPlunge, ::testing::Values(10.0));
+INSTANTIATE_TEST_SUITE_P(Speeds, FemHostInSolverPlunge, ::testing::Values(0.05, 1.0, 5.0, 10.0));
 
 TEST_F(FemHost, BulletsMethodAndAShellBesideAnFemBodyAreRefused) {
   const auto error_of = [](const SceneDescription& s, std::optional<SceneCollisionMethod> method = std::nullopt) {
