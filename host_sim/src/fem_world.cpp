@@ -48,8 +48,8 @@ btVector3 bt(const Eigen::Vector3d& v) { return {static_cast<btScalar>(v.x()), s
 // dv = v_{n+1} − v_n and ends with x_{n+1} = x_n + h·(v_n + dv) (+ the split velocity of its rigid
 // contacts; applyTransforms). So the contact sees the step as the classic solver shows it — m_q
 // the node's start x_n, m_x its predicted end x_n + h·v — and whatever it does to m_x comes back
-// as dv = (m_x − x_n)/h − v_n (a velocity it writes itself, as the rim's inelastic velocities,
-// is taken as is). begin_solve runs on the prediction from Bullet's initial guess (v_n, its rigid
+// as dv = (m_x − x_n)/h − v_n, so Bullet's move puts the node where the projection did (a
+// velocity the contact writes itself replaces v after that move: applyTransforms). begin_solve runs on the prediction from Bullet's initial guess (v_n, its rigid
 // contacts' dv), and project after every Newton iteration: the next iteration's residual is
 // evaluated at the projected positions, so the elastic response of the body around a held node
 // is solved with it, as the classic solver's links are iterated with the contact.
@@ -63,7 +63,6 @@ class FemBodySolver final : public btDeformableBodySolver {
     m_cg = btConjugateGradient<btDeformableBackwardEulerObjective>(max_iterations);
     m_cg.setTolerance(tolerance);
   }
-  [[nodiscard]] bool implicit() const noexcept { return m_implicit; }
   void add_contact(btSoftBody* body, SoftContactConstraint* contact) { contacts_.push_back({body, contact}); }
 
   void solveDeformableConstraints(btScalar h) override {
@@ -121,8 +120,9 @@ class FemBodySolver final : public btDeformableBodySolver {
 
  private:
   // Runs `call` on every contact with m_q = x_n and m_x = x_n + h·(v + split v) of its body, then
-  // takes back what it changed into m_dv (see the class comment) and restores m_x = x_n; m_v is
-  // left at v_n + dv (updateVelocity's), m_q at the prediction (updateState's).
+  // takes back the positions it changed into m_dv and the velocities it wrote into the overrides
+  // (see the class comment) and restores m_x = x_n; m_v is left at v_n + dv (updateVelocity's),
+  // m_q at the prediction (updateState's). The scratch vectors keep their capacity from step to step.
   template <class Call>
   void with_contact_positions(btScalar h, Call call) {
     int offset = 0;
