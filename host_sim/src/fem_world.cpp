@@ -26,13 +26,33 @@
 #include "fem_smoothed_strain_force.hpp"
 #pragma GCC diagnostic pop
 
+#include "fissure/host_sim/node_bounds_solver.hpp"
+
 namespace fissure::host {
 
 namespace {
 
+// Newton residual norm below which the implicit step stops early [N·s] (Bullet's default 1e-4
+// is for bodies of ~1 kg and 100+ N; a tissue specimen carries ~0.01–1 N).
+constexpr btScalar kNewtonTolerance = 1e-9f;
+
+btVector3 bt(const Eigen::Vector3d& v) { return {static_cast<btScalar>(v.x()), static_cast<btScalar>(v.y()), static_cast<btScalar>(v.z())}; }
+
+}  // namespace
+
 // The Newton iteration count and its stopping residual, and the CG solver's iteration cap, are
 // protected members of Bullet's solver (default 1, 1e-4 and 300); a subclass is the only way to
-// set them.
+// set them. It also hosts the in-solver contacts (SoftContactConstraint) in the implicit step.
+//
+// How a position projection enters Bullet's velocity solve: the implicit step solves for
+// dv = v_{n+1} − v_n and ends with x_{n+1} = x_n + h·(v_n + dv) (+ the split velocity of its rigid
+// contacts; applyTransforms). So the contact sees the step as the classic solver shows it — m_q
+// the node's start x_n, m_x its predicted end x_n + h·v — and whatever it does to m_x comes back
+// as dv = (m_x − x_n)/h − v_n, so Bullet's move puts the node where the projection did (a
+// velocity the contact writes itself replaces v after that move: applyTransforms). begin_solve runs on the prediction from Bullet's initial guess (v_n, its rigid
+// contacts' dv), and project after every Newton iteration: the next iteration's residual is
+// evaluated at the projected positions, so the elastic response of the body around a held node
+// is solved with it, as the classic solver's links are iterated with the contact.
 class FemBodySolver final : public btDeformableBodySolver {
  public:
   void set_newton(int iterations, btScalar tolerance) {
@@ -43,15 +63,122 @@ class FemBodySolver final : public btDeformableBodySolver {
     m_cg = btConjugateGradient<btDeformableBackwardEulerObjective>(max_iterations);
     m_cg.setTolerance(tolerance);
   }
+  void add_contact(btSoftBody* body, SoftContactConstraint* contact) { contacts_.push_back({body, contact}); }
+
+  void solveDeformableConstraints(btScalar h) override {
+    velocity_overrides_.clear();
+    if (contacts_.empty() || !m_implicit) {
+      btDeformableBodySolver::solveDeformableConstraints(h);
+      return;
+    }
+    // Bullet's Newton loop (btDeformableBodySolver::solveDeformableConstraints, implicit, without
+    // line search: FemWorld turns it off), each iteration followed by the contacts' projection.
+    updateVelocity();
+    with_contact_positions(h, [](btSoftBody& body, SoftContactConstraint& contact) {
+      contact.begin_solve(body);
+      contact.project(body);
+    });
+    for (int i = 0; i < m_maxNewtonIterations; ++i) {
+      updateState();
+      int counter = 0;
+      for (int k = 0; k < m_softBodies.size(); ++k) {
+        btSoftBody* psb = m_softBodies[k];
+        for (int j = 0; j < psb->m_nodes.size(); ++j, ++counter) {
+          if (psb->m_nodes[j].m_im > 0) m_residual[counter] = (-1. / psb->m_nodes[j].m_im) * m_dv[counter];
+        }
+      }
+      m_objective->computeResidual(h, m_residual);
+      const bool converged = m_objective->computeNorm(m_residual) < m_newtonTolerance && i > 0;
+      if (!converged) {
+        m_objective->applyDynamicFriction(m_residual);
+        computeStep(m_ddv, m_residual);
+        updateDv();
+      }
+      for (int j = 0; j < m_numNodes; ++j) {
+        m_ddv[j].setZero();
+        m_residual[j].setZero();
+      }
+      updateVelocity();
+      with_contact_positions(h, [](btSoftBody& body, SoftContactConstraint& contact) { contact.project(body); });
+      if (converged) break;
+    }
+    with_contact_positions(h, [](btSoftBody& body, SoftContactConstraint& contact) { contact.end_solve(body); });
+    updateVelocity();
+  }
+
+  // Bullet moves every node by h·v; a velocity the contact wrote itself (end_solve: the rim's
+  // inelastic velocities) is what the node carries into the next step, not how far it moves in
+  // this one, so it replaces v after the move.
+  void applyTransforms(btScalar h) override {
+    btDeformableBodySolver::applyTransforms(h);
+    for (const VelocityOverride& o : velocity_overrides_) {
+      o.node->m_v = o.velocity;
+      o.node->m_vn = o.velocity;
+    }
+    velocity_overrides_.clear();
+  }
+
+ private:
+  // Runs `call` on every contact with m_q = x_n and m_x = x_n + h·(v + split v) of its body, then
+  // takes back the positions it changed into m_dv and the velocities it wrote into the overrides
+  // (see the class comment) and restores m_x = x_n; m_v is left at v_n + dv (updateVelocity's),
+  // m_q at the prediction (updateState's). The scratch vectors keep their capacity from step to step.
+  template <class Call>
+  void with_contact_positions(btScalar h, Call call) {
+    int offset = 0;
+    for (int k = 0; k < m_softBodies.size(); ++k) {
+      btSoftBody* psb = m_softBodies[k];
+      const int count = psb->m_nodes.size();
+      bool has_contact = false;
+      for (const auto& c : contacts_) has_contact = has_contact || c.body == psb;
+      if (!has_contact || !psb->isActive()) {
+        offset += count;
+        continue;
+      }
+      start_x_.resize(static_cast<std::size_t>(count));
+      predicted_x_.resize(static_cast<std::size_t>(count));
+      velocity_.resize(static_cast<std::size_t>(count));
+      for (int j = 0; j < count; ++j) {
+        btSoftBody::Node& n = psb->m_nodes[j];
+        const auto u = static_cast<std::size_t>(j);
+        start_x_[u] = n.m_x;
+        velocity_[u] = n.m_v;
+        predicted_x_[u] = n.m_x + h * (n.m_v + n.m_splitv);
+        n.m_q = n.m_x;
+        n.m_x = predicted_x_[u];
+      }
+      for (const auto& c : contacts_) {
+        if (c.body == psb) call(*psb, *c.contact);
+      }
+      const btScalar inverse_h = 1 / h;
+      for (int j = 0; j < count; ++j) {
+        btSoftBody::Node& n = psb->m_nodes[j];
+        const auto u = static_cast<std::size_t>(j);
+        if (n.m_im > 0) {
+          if (n.m_x != predicted_x_[u]) m_dv[offset + j] = (n.m_x - start_x_[u]) * inverse_h - n.m_splitv - m_backupVelocity[offset + j];
+          if (n.m_v != velocity_[u]) velocity_overrides_.push_back({&n, n.m_v});
+        }
+        n.m_x = start_x_[u];
+        n.m_q = predicted_x_[u];
+        n.m_v = velocity_[u];
+      }
+      offset += count;
+    }
+    updateVelocity();
+  }
+
+  struct Contact {
+    btSoftBody* body;
+    SoftContactConstraint* contact;
+  };
+  std::vector<Contact> contacts_;
+  struct VelocityOverride {
+    btSoftBody::Node* node;
+    btVector3 velocity;
+  };
+  std::vector<VelocityOverride> velocity_overrides_;  // end_solve's, applied after the move (applyTransforms)
+  std::vector<btVector3> start_x_, predicted_x_, velocity_;  // per node of the body being projected (reused)
 };
-
-// Newton residual norm below which the implicit step stops early [N·s] (Bullet's default 1e-4
-// is for bodies of ~1 kg and 100+ N; a tissue specimen carries ~0.01–1 N).
-constexpr btScalar kNewtonTolerance = 1e-9f;
-
-btVector3 bt(const Eigen::Vector3d& v) { return {static_cast<btScalar>(v.x()), static_cast<btScalar>(v.y()), static_cast<btScalar>(v.z())}; }
-
-}  // namespace
 
 double thinnest_tetrahedron_m(const VolumeMesh& mesh) noexcept {
   double thinnest = std::numeric_limits<double>::infinity();
@@ -77,6 +204,7 @@ FemWorld::FemWorld(const FemWorldConfig& config) : config_(config) {
   dispatcher_ = std::make_unique<btCollisionDispatcher>(configuration_.get());
   broadphase_ = std::make_unique<btDbvtBroadphase>();
   auto solver = std::make_unique<FemBodySolver>();
+  fem_solver_ = solver.get();
   solver->set_newton(config.implicit ? std::max(1, config.newton_iterations) : 1, kNewtonTolerance);
   solver->set_cg(config.cg_max_iterations, static_cast<btScalar>(config.cg_tolerance));
   deformable_solver_ = std::move(solver);
@@ -192,6 +320,11 @@ void FemWorld::set_box_centre(int box, const Eigen::Vector3d& centre_world_m) no
   btTransform pose = btTransform::getIdentity();
   pose.setOrigin(bt(centre_world_m));
   boxes_[static_cast<std::size_t>(box)]->getMotionState()->setWorldTransform(pose);
+}
+
+void FemWorld::add_solver_contact(int b, SoftContactConstraint* contact) {
+  if (!config_.implicit) throw std::logic_error("FemWorld::add_solver_contact: the contact is solved in the implicit step's Newton iterations; this world steps symplectically");
+  fem_solver_->add_contact(bodies_[static_cast<std::size_t>(b)].get(), contact);
 }
 
 void FemWorld::step(double h_s) noexcept {

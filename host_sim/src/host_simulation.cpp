@@ -129,9 +129,6 @@ HostSimulation::HostSimulation(const SceneDescription& scene, std::optional<Scen
     // pressing in than coming out): after_step's nodes join at the tool's face with x ≈ 0, so it
     // goes without (docs/decisions.md, "Contact inside the solver", fourth session).
     if (params.response == ContactResponse::kAfterStep) params.contact_onset_ramp_s = 0.0;
-    NodeBoundsSolver* solver = world_->node_bounds_solver();
-    if (params.response == ContactResponse::kInSolver && solver == nullptr)
-      throw std::invalid_argument("contact_response = \"in_solver\" needs the instrumented soft-body solver (HostSimulationOptions::solver_node_bounds)");
     for (int b = 0; b < bodies; ++b) {
       btSoftBody& soft = world_->soft(b);
       for (int p = 0; p < parts; ++p) {
@@ -142,11 +139,7 @@ HostSimulation::HostSimulation(const SceneDescription& scene, std::optional<Scen
                                                                                                        : make_ray_collision(nodes, soft, params, bounds);
       }
       if (params.response == ContactResponse::kInSolver) {
-        // The contact is solved in the NodeBoundsSolver's own copy of Bullet's position block, which
-        // it runs only for a body it can reproduce (node_bounds_solver.cpp).
-        if (soft.m_clusters.size() != 0 || soft.m_cfg.diterations != 0 || soft.m_cfg.piterations <= 0)
-          throw std::invalid_argument("contact_response = \"in_solver\" needs a soft body with position iterations, no clusters and no drift iterations");
-        for (int p = 0; p < parts; ++p) solver->add_contact(collisions_[static_cast<std::size_t>(b * parts + p)]->solver_contact(), b);
+        for (int p = 0; p < parts; ++p) world_->add_solver_contact(collisions_[static_cast<std::size_t>(b * parts + p)]->solver_contact(), b);
       }
     }
   }

@@ -47,6 +47,12 @@ constexpr double kGroundOnlyVoxelM = 0.01;
 constexpr int kFemDampedCgIterations = 300;
 constexpr int kFemMaxSubsteps = 64;
 
+// FEM with the in-solver contact: one implicit (backward Euler) step per host step, its Newton
+// iterations each followed by the contact's projection (fem_world.cpp), each a CG solve capped
+// at this many iterations (docs/decisions.md, "Tissue (issue 24)", for the figures behind both).
+constexpr int kFemInSolverNewtonIterations = 1;
+constexpr int kFemInSolverCgIterations = 10;
+
 btVector3 bt(const Vec3& v) { return {static_cast<btScalar>(v[0]), static_cast<btScalar>(v[1]), static_cast<btScalar>(v[2])}; }
 btVector3 bt(const Eigen::Vector3d& v) { return {static_cast<btScalar>(v.x()), static_cast<btScalar>(v.y()), static_cast<btScalar>(v.z())}; }
 
@@ -154,8 +160,11 @@ void SoftWorld::make_tool_parts(const SceneDescription& scene) {
 }
 
 // FEM bodies step in Bullet's deformable world (fem_world.hpp): its own solver, not the classic
-// one the node-bounds solver replaces, so the thin-body contact acts after each step (after_step)
-// and the broad phase reads every node. Every body of the scene is FEM (Bullet's deformable and
+// one the node-bounds solver replaces, so the broad phase reads every node. With after_step the
+// thin-body contact acts after each step; with in_solver each host step is one implicit step whose
+// Newton iterations the contact is projected after (FemWorld::add_solver_contact) — the
+// placement that after_step makes does not survive an implicit step, and the stable step's
+// substeps are what makes after_step costly (docs/decisions.md, "Tissue (issue 24)"). Every body of the scene is FEM (Bullet's deformable and
 // classic soft bodies live in different worlds) and shares the first body's material (Bullet
 // keeps one force per type: FemWorld::add_body). Anchored nodes are fixed (Dirichlet: mass 0),
 // the bed being rigid. The host step is cut into symplectic substeps no longer than the stable
@@ -170,9 +179,6 @@ void SoftWorld::build_fem_world(const SceneDescription& scene) {
   if (parts_in_world_) {
     throw std::invalid_argument("the bullet collision method runs shell bodies only; an FEM body (model = \"fem\") meets the tool through the paired or ray method");
   }
-  if (scene.simulation.contact_response == ContactResponse::kInSolver) {
-    throw std::invalid_argument("[simulation] contact_response = \"in_solver\" solves the contact inside the classic soft body's position iterations; an FEM body (model = \"fem\") takes contact_response = \"after_step\"");
-  }
   FemWorldConfig config;
   config.gravity_world_m_per_s2 = as_eigen(scene.simulation.gravity_world_m_per_s2);
   config.has_ground = true;
@@ -183,6 +189,12 @@ void SoftWorld::build_fem_world(const SceneDescription& scene) {
   const bool stiffness_damped = std::any_of(scene.soft_bodies.begin(), scene.soft_bodies.end(),
                                             [](const SoftBodyDescription& body) { return body.fem.stiffness_damping_s > 0.0; });
   config.cg_max_iterations = stiffness_damped ? kFemDampedCgIterations : 1;
+  const bool in_solver = scene.simulation.contact_response == ContactResponse::kInSolver;
+  if (in_solver) {
+    config.implicit = true;
+    config.newton_iterations = kFemInSolverNewtonIterations;
+    config.cg_max_iterations = kFemInSolverCgIterations;
+  }
   fem_ = std::make_unique<FemWorld>(config);
   const double host_step_s = scene.simulation.time_step_s / std::max(1, scene.simulation.substeps_count);
   double stable_step_s = std::numeric_limits<double>::infinity();
@@ -200,7 +212,7 @@ void SoftWorld::build_fem_world(const SceneDescription& scene) {
   }
   sdf_voxel_m_ = config.sdf_voxel_m;
   fem_start_x_.resize(static_cast<std::size_t>(first_nodes_.back()));
-  fem_substeps_ = std::max(1, static_cast<int>(std::ceil(host_step_s / stable_step_s)));
+  fem_substeps_ = in_solver ? 1 : std::max(1, static_cast<int>(std::ceil(host_step_s / stable_step_s)));
   if (fem_substeps_ > kFemMaxSubsteps) {
     throw std::invalid_argument("[soft_body] model = \"fem\": a " + std::to_string(host_step_s * 1e3) + " ms step needs " + std::to_string(fem_substeps_) +
                                 " substeps for this mesh and material (the stable step is " + std::to_string(stable_step_s * 1e6) +
@@ -311,6 +323,20 @@ SoftWorld::~SoftWorld() {
     }
     world_->removeRigidBody(ground_.get());
   }
+}
+
+void SoftWorld::add_solver_contact(SoftContactConstraint* contact, int body) {
+  if (fem_) {
+    fem_->add_solver_contact(body, contact);
+    return;
+  }
+  if (bounding_solver_ == nullptr) throw std::invalid_argument("contact_response = \"in_solver\" needs the instrumented soft-body solver (HostSimulationOptions::solver_node_bounds)");
+  const btSoftBody& soft = *bodies_[static_cast<std::size_t>(body)];
+  // The contact is solved in the NodeBoundsSolver's own copy of Bullet's position block, which it
+  // runs only for a body it can reproduce (node_bounds_solver.cpp).
+  if (soft.m_clusters.size() != 0 || soft.m_cfg.diterations != 0 || soft.m_cfg.piterations <= 0)
+    throw std::invalid_argument("contact_response = \"in_solver\" needs a soft body with position iterations, no clusters and no drift iterations");
+  bounding_solver_->add_contact(contact, body);
 }
 
 void SoftWorld::set_part_pose(int part, const ToolPose& pose) noexcept {

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -69,10 +70,11 @@ class FemHost : public ::testing::Test {
   std::string scene_text_;
 };
 
-// Plunge speeds 5 cm/s and 1 m/s, ending 6 mm deep. The contact holds the surface nodes only: a
-// press that crushes a 10 mm cell further lets its interior node pass the surface and reach the
-// tool (5 m/s ends 7.5 mm deep: 5 interior nodes in the tool during the hold; 10 m/s, 12.5 mm in
-// one step: 15 through it — docs/decisions.md, "Tissue (issue 24)").
+// Plunge speeds 5 cm/s to 10 m/s, ending 6 mm deep or, in 5 and 10 mm steps, the first step past
+// it (7.5 and 12.6 mm). The block's interior nodes are the contact's candidates as its surface
+// nodes are (broad_phase.cpp, take_faceless): without that, 5 interior nodes entered the tool
+// during the 5 m/s hold and 15 passed through it at 10 m/s, where one step crosses a whole cell
+// (docs/decisions.md, "Tissue (issue 24)").
 class FemHostPlunge : public FemHost, public ::testing::WithParamInterface<double> {};
 
 TEST_P(FemHostPlunge, TheSpatulaPressesTheFemBlockWithNoCrossedNodeAndAForceThatGrowsWithDepth) {
@@ -115,8 +117,10 @@ TEST_P(FemHostPlunge, TheSpatulaPressesTheFemBlockWithNoCrossedNodeAndAForceThat
   }
   EXPECT_EQ(crossed_max, 0);
   EXPECT_TRUE(finite);
-  EXPECT_GT(force_at_3mm, 0.0);           // the tissue pushes the tool up
-  EXPECT_GT(force_at_6mm, force_at_3mm);  // and harder the deeper it goes
+  EXPECT_GT(force_at_3mm, 0.0);  // the tissue pushes the tool up
+  if (speed_m_per_s * dt < 0.003) {
+    EXPECT_GT(force_at_6mm, force_at_3mm);  // and harder the deeper it goes (3 and 6 mm: one step above 3 mm a step)
+  }
   // Held there, the body does not creep through the tool, and the fixed underside stays put.
   double held_force_n = 0.0;
   for (int i = 0; i < 200; ++i) {
@@ -135,9 +139,91 @@ TEST_P(FemHostPlunge, TheSpatulaPressesTheFemBlockWithNoCrossedNodeAndAForceThat
   EXPECT_EQ(unmoved, fixed);
 }
 
-INSTANTIATE_TEST_SUITE_P(Speeds, FemHostPlunge, ::testing::Values(0.05, 1.0));
+INSTANTIATE_TEST_SUITE_P(Speeds, FemHostPlunge, ::testing::Values(0.05, 1.0, 5.0, 10.0));
 
-TEST_F(FemHost, InSolverContactBulletsMethodAndAShellBesideAnFemBodyAreRefused) {
+// The in-solver contact (contact_response = "in_solver"): one implicit step per 1 ms host step,
+// the contact projected after each of its Newton iterations (fem_world.cpp). Plunge speeds 5 cm/s
+// to 10 m/s as above (10 m/s: one 10 mm step through a 10 mm cell), then held 0.2 s.
+class FemHostInSolverPlunge : public FemHost, public ::testing::WithParamInterface<double> {};
+
+TEST_P(FemHostInSolverPlunge, TheImplicitStepHoldsTheContactWithNoCrossedNode) {
+  const SceneDescription description = scene(replace(scene_text_, "collision_method = \"paired\"", "collision_method = \"paired\"\ncontact_response = \"in_solver\""));
+  ASSERT_EQ(description.simulation.contact_response, ContactResponse::kInSolver);
+  HostSimulation sim(description);
+  ASSERT_NE(sim.world().fem_world(), nullptr);
+  EXPECT_EQ(sim.world().fem_substeps(), 1);  // one implicit step, not the stable step's substeps
+
+  sim.settle(0.3);
+  const btSoftBody& soft = sim.world().soft();
+  double top_m = 0.0;
+  for (int i = 0; i < soft.m_nodes.size(); ++i) top_m = std::max(top_m, static_cast<double>(soft.m_nodes[i].m_x.y()));
+  EXPECT_LT(top_m, kBlockTop_m);
+  EXPECT_GT(top_m, kBlockTop_m - 0.004);
+
+  const double half_thickness_m = 0.001, speed_m_per_s = GetParam(), dt = description.simulation.time_step_s;
+  ToolPose pose = sim.tool_pose();
+  double force_at_3mm = -1.0, force_at_6mm = -1.0, penetration_max_m = 0.0;
+  int crossed_max = 0;
+  bool finite = true;
+  for (int i = 0; i < 2000; ++i) {
+    pose.position_world_m.y() -= speed_m_per_s * dt;
+    const HostStepResult& r = sim.step(pose);
+    crossed_max = std::max(crossed_max, r.crossing.crossed_nodes);
+    penetration_max_m = std::max(penetration_max_m, r.crossing.max_penetration_m);
+    finite = finite && r.force_on_tool_world_n.allFinite();
+    const double depth_m = top_m - (pose.position_world_m.y() - half_thickness_m);
+    if (force_at_3mm < 0.0 && depth_m >= 0.003) force_at_3mm = r.force_on_tool_world_n.y();
+    if (depth_m >= 0.006) {
+      force_at_6mm = r.force_on_tool_world_n.y();
+      break;
+    }
+  }
+  // Held 0.2 s; the force's mean and spread over its last 0.1 s (the plunge's ringing decays first).
+  double held_sum = 0.0, held_sum2 = 0.0, held_force_n = 0.0;
+  constexpr int kHoldSteps = 200, kMeasuredSteps = 100;
+  for (int i = 0; i < kHoldSteps; ++i) {
+    const HostStepResult& r = sim.step(pose);
+    crossed_max = std::max(crossed_max, r.crossing.crossed_nodes);
+    penetration_max_m = std::max(penetration_max_m, r.crossing.max_penetration_m);
+    finite = finite && r.force_on_tool_world_n.allFinite();
+    held_force_n = r.force_on_tool_world_n.y();
+    if (i < kHoldSteps - kMeasuredSteps) continue;
+    held_sum += held_force_n;
+    held_sum2 += held_force_n * held_force_n;
+  }
+  const double held_mean = held_sum / kMeasuredSteps;
+  const double held_std = std::sqrt(std::max(0.0, held_sum2 / kMeasuredSteps - held_mean * held_mean));
+  std::printf("in_solver %.2f m/s: crossed %d, penetration %.3f mm, F 3 mm %.4f N, 6 mm %.4f N, held %.4f N (mean %.4f, std %.5f)\n", speed_m_per_s,
+              crossed_max, penetration_max_m * 1e3, force_at_3mm, force_at_6mm, held_force_n, held_mean, held_std);
+  EXPECT_EQ(crossed_max, 0);
+  EXPECT_LT(penetration_max_m, 1e-6);
+  EXPECT_TRUE(finite);
+  EXPECT_GT(force_at_3mm, 0.0);
+  // Above 3 mm a step, 3 and 6 mm deep are the same step.
+  if (speed_m_per_s * dt < 0.003) {
+    EXPECT_GT(force_at_6mm, force_at_3mm);
+  }
+  // The held force: within 0.5–1.5 N at 6 mm (0.70 N at 5 cm/s on 57 contacts; after_step holds
+  // 1.55 N on 88 here, docs/decisions.md), scaled as x^1.5 to the depth the plunge ended at
+  // (Hunt-Crossley's exponent), and steady over the hold's last 0.1 s (measured: 0.2 % at 5 cm/s,
+  // 3.5 % at 1 m/s, 3 % at 10 m/s). At 5 m/s the plunge ends 7.5 mm deep in one 5 mm step and the
+  // body still rings with its mass damping (10 /s): 9 %.
+  const double depth_scale = std::pow((top_m - (pose.position_world_m.y() - half_thickness_m)) / 0.006, 1.5);
+  EXPECT_GT(held_mean, 0.5 * depth_scale);
+  EXPECT_LT(held_mean, 1.5 * depth_scale);
+  EXPECT_LT(held_std, (speed_m_per_s < 2.0 ? 0.05 : 0.15) * held_mean);
+  int unmoved = 0;
+  for (int i = 0; i < soft.m_nodes.size(); ++i) {
+    if (soft.m_nodes[i].m_im != 0) continue;
+    const Vec3& rest = block_.vertices_m[static_cast<std::size_t>(i)];
+    unmoved += std::abs(static_cast<double>(soft.m_nodes[i].m_x.y()) - (rest[1] + 0.002)) < 1e-6 ? 1 : 0;
+  }
+  EXPECT_EQ(unmoved, sim.world().anchored_nodes_count());
+}
+
+INSTANTIATE_TEST_SUITE_P(Speeds, FemHostInSolverPlunge, ::testing::Values(0.05, 1.0, 5.0, 10.0));
+
+TEST_F(FemHost, BulletsMethodAndAShellBesideAnFemBodyAreRefused) {
   const auto error_of = [](const SceneDescription& s, std::optional<SceneCollisionMethod> method = std::nullopt) {
     try {
       HostSimulation sim(s, method);
@@ -146,8 +232,6 @@ TEST_F(FemHost, InSolverContactBulletsMethodAndAShellBesideAnFemBodyAreRefused) 
     }
     return std::string("no error");
   };
-  const std::string in_solver = replace(scene_text_, "collision_method = \"paired\"", "collision_method = \"paired\"\ncontact_response = \"in_solver\"");
-  EXPECT_NE(error_of(scene(in_solver)).find("an FEM body (model = \"fem\") takes contact_response = \"after_step\""), std::string::npos) << error_of(scene(in_solver));
   EXPECT_NE(error_of(scene(scene_text_), SceneCollisionMethod::kBullet).find("meets the tool through the paired or ray method"), std::string::npos);
   // A second body, a shell: the two models live in different Bullet worlds.
   SceneDescription mixed = scene(scene_text_);

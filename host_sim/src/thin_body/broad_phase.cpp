@@ -288,6 +288,22 @@ class Collector {
     return query_.seed(box);
   }
 
+  // A node of no face (a volume's interior: an FEM body's nodes inside its boundary triangles) is
+  // reached by no face, so it is a candidate on its own when its start/end box meets the face
+  // query: the response then keeps it out of the tool as it keeps a surface node (a tool that
+  // crosses a whole cell in one step passes the interior node the surface contact does not hold).
+  void take_faceless(int node) {
+    const auto n = static_cast<std::size_t>(node);
+    if (model_.soft.faces_of_node_begin[n] != model_.soft.faces_of_node_begin[n + 1]) return;
+    if (data_.broad.listed_stamp[n] == frame_.step) return;
+    transform(node);
+    Eigen::AlignedBox3d box_tool(data_.broad.start_tool_m[n]);
+    box_tool.extend(data_.broad.end_tool_m[n]);
+    if (!query_.face_needed(box_tool)) return;
+    data_.broad.listed_stamp[n] = frame_.step;
+    data_.broad.candidate_nodes.push_back(node);
+  }
+
   // Every face around a seed or around last step's candidate (whatever its leaf says), once a step.
   void reach_faces_around(int node) {
     const auto n = static_cast<std::size_t>(node);
@@ -558,6 +574,10 @@ bool broad_phase(const CollisionModel& model, const StepFrame& frame, const btSo
   // The exact test, in the order the faces were reached.
   prefetch_kept_faces(model, data);
   collect.test_kept_faces();
+  if (model.soft.has_faceless_nodes) {
+    for (const int node : data.broad.previous_candidates) collect.take_faceless(node);
+    for (const int node : data.broad.scan_hits) collect.take_faceless(node);
+  }
   // A canonical order for the later stages: the node sweep gives a tool node to the FIRST of
   // several triangles it touches at the same moment (a held node: τ = 1 on each), so the
   // traversal order would otherwise decide contacts (clamp scenes: ±25 % peak force between two

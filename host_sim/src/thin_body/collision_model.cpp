@@ -116,8 +116,11 @@ CollisionModel build_collision_model(const ToolNodes& tool, const btSoftBody& so
       ++surface.faces_of_node_begin[static_cast<std::size_t>(index + 1)];
     }
   }
-  for (int i = 0; i < surface.node_count; ++i)
-    surface.faces_of_node_begin[static_cast<std::size_t>(i + 1)] += surface.faces_of_node_begin[static_cast<std::size_t>(i)];
+  for (int i = 0; i < surface.node_count; ++i) {
+    const auto n = static_cast<std::size_t>(i);
+    surface.has_faceless_nodes = surface.has_faceless_nodes || surface.faces_of_node_begin[n + 1] == 0;  // counts, before the sum
+    surface.faces_of_node_begin[n + 1] += surface.faces_of_node_begin[n];
+  }
   surface.faces_of_node.assign(static_cast<std::size_t>(surface.faces_of_node_begin.back()), -1);
   std::vector<int> fill(surface.faces_of_node_begin.begin(), surface.faces_of_node_begin.end() - 1);
   for (int f = 0; f < surface.face_count; ++f)

@@ -36,6 +36,7 @@ struct SoftSurfaceModel {
   std::vector<std::array<int, 3>> face_nodes;
   std::vector<int> faces_of_node_begin;  // CSR: faces around each node
   std::vector<int> faces_of_node;
+  bool has_faceless_nodes = false;  // a volume's interior nodes (broad_phase.cpp: take_faceless)
   std::vector<Eigen::Vector3d> rest_node_world_m;      // rest positions (world, when the rest state was taken)
   std::vector<Eigen::Vector3d> rest_centroid_world_m;  // centroid_distance's rest centroids
   std::vector<double> rest_area_m2;

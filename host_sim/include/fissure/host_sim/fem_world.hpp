@@ -41,6 +41,9 @@ class btSoftBodyRigidBodyCollisionConfiguration;
 
 namespace fissure::host {
 
+class SoftContactConstraint;
+class FemBodySolver;
+
 struct FemWorldConfig {
   Eigen::Vector3d gravity_world_m_per_s2 = Eigen::Vector3d::Zero();
   bool has_ground = false;            ///< a static box whose top face is y = ground_top_y_m
@@ -99,6 +102,12 @@ class FemWorld {
   /// Moves a kinematic box (Bullet derives its velocity from the previous pose).
   void set_box_centre(int box, const Eigen::Vector3d& centre_world_m) noexcept;
 
+  /// Solve `contact` with body b inside the implicit step's Newton iterations (the thin-body
+  /// in-solver response, fem_world.cpp says how a position projection enters a velocity solve).
+  /// Implicit worlds only (std::logic_error otherwise): the symplectic step has no iteration to
+  /// project in. Not owned: it must outlive the world.
+  void add_solver_contact(int b, SoftContactConstraint* contact);
+
   /// One step of h seconds (one internal substep).
   void step(double h_s) noexcept;
 
@@ -115,6 +124,7 @@ class FemWorld {
   std::unique_ptr<btCollisionDispatcher> dispatcher_;
   std::unique_ptr<btBroadphaseInterface> broadphase_;
   std::unique_ptr<btDeformableBodySolver> deformable_solver_;
+  FemBodySolver* fem_solver_ = nullptr;  ///< = deformable_solver_
   std::unique_ptr<btDeformableMultiBodyConstraintSolver> constraint_solver_;
   std::unique_ptr<btDeformableMultiBodyDynamicsWorld> world_;
   std::vector<std::unique_ptr<btCollisionShape>> shapes_;

@@ -84,6 +84,10 @@ class SoftWorld {
   [[nodiscard]] SoftNodeBounds* node_bounds(int body = 0) noexcept { return bounding_solver_ != nullptr ? &bounding_solver_->bounds(body) : nullptr; }
   /// The solver behind node_bounds() (it also solves the in-solver contacts); null as above.
   [[nodiscard]] NodeBoundsSolver* node_bounds_solver() noexcept { return bounding_solver_; }
+  /// Solve `contact` inside body `body`'s step (contact_response = "in_solver"): in the
+  /// NodeBoundsSolver's position iterations for a shell, in the implicit step's Newton iterations
+  /// for an FEM body. Throws std::invalid_argument for a world that cannot host it.
+  void add_solver_contact(SoftContactConstraint* contact, int body);
   [[nodiscard]] double sdf_voxel_m() const noexcept { return sdf_voxel_m_; }
   /// Soft nodes tied to the ground by [[soft_body.anchor]], over every body (0: free bodies).
   [[nodiscard]] int anchored_nodes_count() const noexcept { return anchored_nodes_count_; }
