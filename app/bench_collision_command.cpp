@@ -37,7 +37,7 @@ void register_bench_collision(CommandTree& tree) {
       ->capture_default_str();
   cmd->add_option("--soft-model", a->soft_model,
                   "Sweep and levering cells' ball: shell (the paper's edge-link shell) or fem (the same surface filled with tetrahedra, "
-                  "an FEM body on a bed; with --only sweep --only cells)")
+                  "an FEM body on a bed, with --contact-response; with --only sweep --only cells)")
       ->check(CLI::IsMember({"shell", "fem"}))
       ->capture_default_str();
   cmd->callback([a] {

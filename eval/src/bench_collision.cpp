@@ -140,7 +140,8 @@ SceneDescription sphere_scene(int faces, bool icosphere, host::ContactResponse r
 
 // A sweep or levering cell's scene: the shell cell (plunge_cell_scene) or its volumetric ball.
 SceneDescription cell_scene(const host::PlungeTool& tool, int icosphere_faces, const BenchCollisionOptions& o) {
-  if (o.soft_model == host::SoftBodyModel::kFem) return host::volumetric_plunge_scene(host::plunge_scene(tool, icosphere_faces), icosphere_faces);
+  if (o.soft_model == host::SoftBodyModel::kFem)
+    return host::volumetric_plunge_scene(host::plunge_scene(tool, icosphere_faces), icosphere_faces, o.contact_response, o.in_solver_tool_friction);
   return host::plunge_cell_scene(tool, icosphere_faces, o.contact_response, o.in_solver_tool_friction);
 }
 
@@ -205,8 +206,9 @@ void run_sweep(const BenchCollisionOptions& o, nlohmann::json& out) {
   const double hold_s = o.quick ? 0.1 : 0.5;
   const bool fem = o.soft_model == host::SoftBodyModel::kFem;
   if (fem) {
-    std::printf("\n1. Tunnelling sweep on the volumetric ball (the 128-face surface filled with tetrahedra, FEM E %.0f kPa, on its bed, after_step;"
-                " 1 kHz, plunge %.0f mm, hold %.1f s)\n", host::kPlungeFemYoungsModulus_pa * 1e-3, host::kPlungeDepth_m * 1e3, hold_s);
+    std::printf("\n1. Tunnelling sweep on the volumetric ball (the 128-face surface filled with tetrahedra, FEM E %.0f kPa, on its bed, %s;"
+                " 1 kHz, plunge %.0f mm, hold %.1f s)\n", host::kPlungeFemYoungsModulus_pa * 1e-3, host::to_string(o.contact_response),
+                host::kPlungeDepth_m * 1e3, hold_s);
   } else {
     std::printf("\n1. Tunnelling sweep (sphere 128 faces with pose matching kMT %.2f, 1 kHz, plunge %.0f mm, hold %.1f s)\n", kShapeMatchingRatio,
                 host::kPlungeDepth_m * 1e3, hold_s);

@@ -53,7 +53,7 @@ SceneDescription plunge_cell_scene(const PlungeTool& tool, int icosphere_faces, 
   return scene;
 }
 
-SceneDescription volumetric_plunge_scene(SceneDescription scene, int icosphere_faces) {
+SceneDescription volumetric_plunge_scene(SceneDescription scene, int icosphere_faces, ContactResponse response, bool tool_friction) {
   if (icosphere_faces != 0 && icosphere_faces != 1280)
     throw std::invalid_argument("the volumetric sweep ball is the 128-face shell's (icosphere_faces 0) or the 1280-face icosphere's, got " +
                                 std::to_string(icosphere_faces));
@@ -82,8 +82,10 @@ SceneDescription volumetric_plunge_scene(SceneDescription scene, int icosphere_f
   bed.max_world_m = {1.0, scene.ground.top_height_m + kPlungeBedTop_m, 1.0};
   soft.anchors.push_back(bed);
   scene.soft_bodies = {std::move(soft)};
-  scene.simulation.contact_response = ContactResponse::kAfterStep;
-  scene.tool.friction_static_ratio = scene.tool.friction_kinetic_ratio = 0.0;
+  scene.simulation.contact_response = response;
+  const bool friction = response == ContactResponse::kInSolver && tool_friction;
+  scene.tool.friction_static_ratio = friction ? kPlungeFrictionStaticRatio : 0.0;
+  scene.tool.friction_kinetic_ratio = friction ? kPlungeFrictionKineticRatio : 0.0;
   return scene;
 }
 

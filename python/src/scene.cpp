@@ -52,16 +52,12 @@ const host::PlungeTool& plunge_tool_named(const std::string& name) {
 }
 
 // The sweep's cell scene (host::plunge_cell_scene) for a response named as in scene files.
-// soft_model "fem": the volumetric sweep ball (host::volumetric_plunge_scene; after_step only).
+// soft_model "fem": the volumetric sweep ball (host::volumetric_plunge_scene).
 SceneDescription plunge_cell_scene(const host::PlungeTool& tool, const std::string& contact_response, bool tool_friction, int icosphere_faces,
                                    const std::string& soft_model) {
   const std::optional<host::ContactResponse> response = host::parse_contact_response(contact_response);
   if (!response) throw std::invalid_argument("contact_response '" + contact_response + "' is not one of: after_step, in_solver");
-  if (soft_model == "fem") {
-    if (*response != host::ContactResponse::kAfterStep)
-      throw std::invalid_argument("soft_model 'fem': the volumetric ball takes contact_response 'after_step'");
-    return host::volumetric_plunge_scene(host::plunge_scene(tool, icosphere_faces), icosphere_faces);
-  }
+  if (soft_model == "fem") return host::volumetric_plunge_scene(host::plunge_scene(tool, icosphere_faces), icosphere_faces, *response, tool_friction);
   if (soft_model != "shell") throw std::invalid_argument("soft_model '" + soft_model + "' is not one of: shell, fem");
   return host::plunge_cell_scene(tool, icosphere_faces, *response, tool_friction);
 }
@@ -231,7 +227,7 @@ void bind_scene(py::module_& m) {
       "spatula-sphere with the named plunge tool and the plunge ball's pose matching (the sweep's scene); contact_response\n"
       "'in_solver' gives the bench's in-solver cell (the ball's bed anchored; tool_friction: the plunge's Coulomb friction\n"
       "with the default viscous shear); icosphere_faces: an icosphere ball instead (1280: the sweep's fine ball);\n"
-      "soft_model 'fem': the same surface filled with tetrahedra, an FEM body on the bed (after_step).");
+      "soft_model 'fem': the same surface filled with tetrahedra, an FEM body on the bed.");
   m.def(
       "run_plunge_hold",
       [](const std::string& tool_name, const std::string& method, double speed_m_s, double hold_s, bool count_cut_triangles,

@@ -20,8 +20,9 @@ struct BenchCollisionOptions {
   /// In-solver plunge and levering cells: the tool's faces have friction 0.5 / 0.4 (true) or none.
   bool in_solver_tool_friction = true;
   /// The sweep and levering cells' ball: the paper's shell (kShell) or the same surface filled
-  /// with tetrahedra, an FEM body (kFem: host::volumetric_plunge_scene, after_step; the sweep,
-  /// levering only — Bullet's method and the clamp cell's ball are shells).
+  /// with tetrahedra, an FEM body (kFem: host::volumetric_plunge_scene, with contact_response and
+  /// the in-solver friction; the sweep and levering only — Bullet's method and the clamp cell's
+  /// ball are shells).
   host::SoftBodyModel soft_model = host::SoftBodyModel::kShell;
   [[nodiscard]] bool runs(const char* part) const;
 };

@@ -86,15 +86,17 @@ inline constexpr double kPlungeBedTop_m = 0.015;
 /// It asks whether what the shell cells miss (hold jitter after the shell's own settling,
 /// docs/decisions.md) is the shell's: an elastic volume has a restoring force everywhere.
 /// E 20 kPa: the box spatula's 1 cm press of spatula-sphere then holds 6.01 N on this ball, the
-/// shell's 5.96 N (`fissure sim` on the scene with this body); within soft tissue's 1–100 kPa
+/// shell's 5.96 N (`fissure sim` on the scene with this body, after_step); within soft tissue's 1–100 kPa
 /// (brain 1–3, liver 5–10, muscle 10–100 kPa; fem_material.hpp has the sources).
 inline constexpr double kPlungeFemYoungsModulus_pa = 20000.0;
 /// Mass damping [1/s]: spatula-fem-lobe's, which settles a body on its bed within ~0.3 s.
 inline constexpr double kPlungeFemMassDamping_per_s = 10.0;
 /// `scene` (a plunge scene) with the volumetric ball of `icosphere_faces` faces (0: 128, or 1280)
-/// on the bed; after_step (the FEM body's contact response). Throws std::invalid_argument for
-/// another face count, MeshError when the shipped mesh cannot be read.
-[[nodiscard]] SceneDescription volumetric_plunge_scene(SceneDescription scene, int icosphere_faces);
+/// on the bed, with `response`; in_solver with the in-solver cells' tool friction unless
+/// `tool_friction` is false (after_step has none). Throws std::invalid_argument for another face
+/// count, MeshError when the shipped mesh cannot be read.
+[[nodiscard]] SceneDescription volumetric_plunge_scene(SceneDescription scene, int icosphere_faces,
+                                                       ContactResponse response = ContactResponse::kAfterStep, bool tool_friction = true);
 
 /// Where a plunge starts: the tool kPlungeStartClearance_m above the settled soft surface, and
 /// the height of its origin once the leading face is kPlungeDepth_m below that surface [m, world y].
