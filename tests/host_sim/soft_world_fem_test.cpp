@@ -65,6 +65,39 @@ class FemHost : public ::testing::Test {
 
   [[nodiscard]] SceneDescription scene(const std::string& text) const { return load_scene_text(text, "fem-block.toml", kScenes); }
 
+  // The settled block's top [m, world y].
+  [[nodiscard]] static double block_top_m(const btSoftBody& soft) {
+    double top_m = 0.0;
+    for (int i = 0; i < soft.m_nodes.size(); ++i) top_m = std::max(top_m, static_cast<double>(soft.m_nodes[i].m_x.y()));
+    return top_m;
+  }
+
+  // Drives the spatula down at `speed` until its lower face (1 mm below its centre) is 6 mm below
+  // `top_m`, noting the force as it passes 3 and 6 mm and the worst crossing on the way.
+  struct Plunge {
+    double force_at_3mm_n = -1.0, force_at_6mm_n = -1.0, penetration_max_m = 0.0, depth_m = 0.0;
+    int crossed_max = 0;
+    bool finite = true;
+  };
+  static constexpr double kSpatulaHalfThickness_m = 0.001;
+  static Plunge plunge_6mm(HostSimulation& sim, ToolPose& pose, double top_m, double speed_m_per_s, double dt_s) {
+    Plunge out;
+    for (int i = 0; i < 2000; ++i) {
+      pose.position_world_m.y() -= speed_m_per_s * dt_s;
+      const HostStepResult& r = sim.step(pose);
+      out.crossed_max = std::max(out.crossed_max, r.crossing.crossed_nodes);
+      out.penetration_max_m = std::max(out.penetration_max_m, r.crossing.max_penetration_m);
+      out.finite = out.finite && r.force_on_tool_world_n.allFinite();
+      out.depth_m = top_m - (pose.position_world_m.y() - kSpatulaHalfThickness_m);
+      if (out.force_at_3mm_n < 0.0 && out.depth_m >= 0.003) out.force_at_3mm_n = r.force_on_tool_world_n.y();
+      if (out.depth_m >= 0.006) {
+        out.force_at_6mm_n = r.force_on_tool_world_n.y();
+        break;
+      }
+    }
+    return out;
+  }
+
   std::filesystem::path dir_;
   TetMesh block_;
   std::string scene_text_;
@@ -92,34 +125,19 @@ TEST_P(FemHostPlunge, TheSpatulaPressesTheFemBlockWithNoCrossedNodeAndAForceThat
 
   sim.settle(0.3);
   const btSoftBody& soft = sim.world().soft();
-  double top_m = 0.0;
-  for (int i = 0; i < soft.m_nodes.size(); ++i) top_m = std::max(top_m, static_cast<double>(soft.m_nodes[i].m_x.y()));
+  const double top_m = block_top_m(soft);
   EXPECT_LT(top_m, kBlockTop_m);           // it sags under its weight ...
   EXPECT_GT(top_m, kBlockTop_m - 0.004);  // ... a little (E 3 kPa, 20 mm thick, fixed underneath)
 
-  // Down at the plunge speed until the spatula's lower face (1 mm below its centre) is 6 mm below the top.
-  const double half_thickness_m = 0.001, speed_m_per_s = GetParam(), dt = description.simulation.time_step_s;
+  const double speed_m_per_s = GetParam(), dt = description.simulation.time_step_s;
   ToolPose pose = sim.tool_pose();
-  double force_at_3mm = -1.0, force_at_6mm = -1.0;
-  int crossed_max = 0;
-  bool finite = true;
-  for (int i = 0; i < 2000; ++i) {
-    pose.position_world_m.y() -= speed_m_per_s * dt;
-    const HostStepResult& r = sim.step(pose);
-    crossed_max = std::max(crossed_max, r.crossing.crossed_nodes);
-    finite = finite && r.force_on_tool_world_n.allFinite();
-    const double depth_m = top_m - (pose.position_world_m.y() - half_thickness_m);
-    if (force_at_3mm < 0.0 && depth_m >= 0.003) force_at_3mm = r.force_on_tool_world_n.y();
-    if (depth_m >= 0.006) {
-      force_at_6mm = r.force_on_tool_world_n.y();
-      break;
-    }
-  }
+  const Plunge plunge = plunge_6mm(sim, pose, top_m, speed_m_per_s, dt);
+  int crossed_max = plunge.crossed_max;
   EXPECT_EQ(crossed_max, 0);
-  EXPECT_TRUE(finite);
-  EXPECT_GT(force_at_3mm, 0.0);  // the tissue pushes the tool up
+  EXPECT_TRUE(plunge.finite);
+  EXPECT_GT(plunge.force_at_3mm_n, 0.0);  // the tissue pushes the tool up
   if (speed_m_per_s * dt < 0.003) {
-    EXPECT_GT(force_at_6mm, force_at_3mm);  // and harder the deeper it goes (3 and 6 mm: one step above 3 mm a step)
+    EXPECT_GT(plunge.force_at_6mm_n, plunge.force_at_3mm_n);  // and harder the deeper it goes (3 and 6 mm: one step above 3 mm a step)
   }
   // Held there, the body does not creep through the tool, and the fixed underside stays put.
   double held_force_n = 0.0;
@@ -155,29 +173,17 @@ TEST_P(FemHostInSolverPlunge, TheImplicitStepHoldsTheContactWithNoCrossedNode) {
 
   sim.settle(0.3);
   const btSoftBody& soft = sim.world().soft();
-  double top_m = 0.0;
-  for (int i = 0; i < soft.m_nodes.size(); ++i) top_m = std::max(top_m, static_cast<double>(soft.m_nodes[i].m_x.y()));
+  const double top_m = block_top_m(soft);
   EXPECT_LT(top_m, kBlockTop_m);
   EXPECT_GT(top_m, kBlockTop_m - 0.004);
 
-  const double half_thickness_m = 0.001, speed_m_per_s = GetParam(), dt = description.simulation.time_step_s;
+  const double speed_m_per_s = GetParam(), dt = description.simulation.time_step_s;
   ToolPose pose = sim.tool_pose();
-  double force_at_3mm = -1.0, force_at_6mm = -1.0, penetration_max_m = 0.0;
-  int crossed_max = 0;
-  bool finite = true;
-  for (int i = 0; i < 2000; ++i) {
-    pose.position_world_m.y() -= speed_m_per_s * dt;
-    const HostStepResult& r = sim.step(pose);
-    crossed_max = std::max(crossed_max, r.crossing.crossed_nodes);
-    penetration_max_m = std::max(penetration_max_m, r.crossing.max_penetration_m);
-    finite = finite && r.force_on_tool_world_n.allFinite();
-    const double depth_m = top_m - (pose.position_world_m.y() - half_thickness_m);
-    if (force_at_3mm < 0.0 && depth_m >= 0.003) force_at_3mm = r.force_on_tool_world_n.y();
-    if (depth_m >= 0.006) {
-      force_at_6mm = r.force_on_tool_world_n.y();
-      break;
-    }
-  }
+  const Plunge plunge = plunge_6mm(sim, pose, top_m, speed_m_per_s, dt);
+  const double force_at_3mm = plunge.force_at_3mm_n, force_at_6mm = plunge.force_at_6mm_n;
+  double penetration_max_m = plunge.penetration_max_m;
+  int crossed_max = plunge.crossed_max;
+  bool finite = plunge.finite;
   // Held 0.2 s; the force's mean and spread over its last 0.1 s (the plunge's ringing decays first).
   double held_sum = 0.0, held_sum2 = 0.0, held_force_n = 0.0;
   constexpr int kHoldSteps = 200, kMeasuredSteps = 100;
@@ -208,7 +214,7 @@ TEST_P(FemHostInSolverPlunge, TheImplicitStepHoldsTheContactWithNoCrossedNode) {
   // (Hunt-Crossley's exponent), and steady over the hold's last 0.1 s (measured: 0.2 % at 5 cm/s,
   // 3.5 % at 1 m/s, 3 % at 10 m/s). At 5 m/s the plunge ends 7.5 mm deep in one 5 mm step and the
   // body still rings with its mass damping (10 /s): 9 %.
-  const double depth_scale = std::pow((top_m - (pose.position_world_m.y() - half_thickness_m)) / 0.006, 1.5);
+  const double depth_scale = std::pow(plunge.depth_m / 0.006, 1.5);
   EXPECT_GT(held_mean, 0.5 * depth_scale);
   EXPECT_LT(held_mean, 1.5 * depth_scale);
   EXPECT_LT(held_std, (speed_m_per_s < 2.0 ? 0.05 : 0.15) * held_mean);
