@@ -80,6 +80,7 @@ void write_meshes(const std::string& dir) {
 struct SimOptions {
   std::string scene;
   std::string method;
+  std::string contact_response;  ///< empty: the scene's
   double seconds = -1.0;
   double settle_seconds = 0.5;
   std::string json_path;
@@ -224,6 +225,7 @@ void write_json(const SimOptions& options, const std::filesystem::path& path, co
   j["scene"] = scene.name;
   j["scene_file"] = scene.source_path;
   j["method"] = host::to_string(sim.method());
+  j["contact_response"] = host::to_string(scene.simulation.contact_response);
   j["faces"] = sim.soft_face_count();
   j["nodes"] = sim.soft_node_count();
   j["time_step_s"] = scene.simulation.time_step_s;
@@ -254,6 +256,17 @@ std::unique_ptr<host::HostSimulation> open_simulation(const SimOptions& options,
     scene = session::load_plausible_scene(options.scene);
   } catch (const host::SceneError& e) {
     throw CommandError(e.what());
+  }
+  if (!options.contact_response.empty()) {
+    // The loader ties the tool's friction to the in-solver response (it is solved in its
+    // iterations); overriding the response does not drop a friction the scene asks for.
+    const host::ContactResponse response = *host::parse_contact_response(options.contact_response);  // IsMember checked the name
+    if (response == host::ContactResponse::kAfterStep && scene.tool.friction_static_ratio > 0.0) {
+      throw CommandError(scene.source_path + ": --contact-response after_step: the scene's tool has friction (friction_static_ratio " +
+                         config::format_number(scene.tool.friction_static_ratio) +
+                         "), which only the in_solver response solves; use a copy of the scene without the tool's friction keys");
+    }
+    scene.simulation.contact_response = response;
   }
   try {
     return std::make_unique<host::HostSimulation>(scene, method);
@@ -294,8 +307,9 @@ void run_sim(const SimOptions& options) {
   const std::filesystem::path staged_frames =
       options.frames_dir.empty() ? std::filesystem::path() : staging.directory(options.frames_dir, "frame_", ".png");
   std::unique_ptr<viewer::SessionView> view = start_frames(options, *sim, steps, staged_frames);
-  std::printf("scene %s: %s, method %s, %d faces / %d nodes, %ld steps of %.3g ms\n", scene.name.c_str(), scene.description.c_str(),
-              host::to_string(sim->method()), sim->soft_face_count(), sim->soft_node_count(), steps, dt * 1e3);
+  std::printf("scene %s: %s, method %s (%s), %d faces / %d nodes, %ld steps of %.3g ms\n", scene.name.c_str(), scene.description.c_str(),
+              host::to_string(sim->method()), host::to_string(scene.simulation.contact_response), sim->soft_face_count(), sim->soft_node_count(),
+              steps, dt * 1e3);
   SimProgress progress("sim " + scene.name, steps);
   SimFigures figures;
   for (long i = 0; i < steps; ++i) {
@@ -341,6 +355,9 @@ void register_sim(CommandTree& tree) {
   CLI::App* sim = tree.root.add_subcommand("sim", "Run a scene's host simulation headless on its scripted tool trajectory");
   sim->add_option("scene", options->scene, "Scene name (scenes/NAME.toml) or path to a scene file");
   sim->add_option("--method", options->method, "Collision method: paired | ray | bullet (default: the scene's)");
+  sim->add_option("--contact-response", options->contact_response,
+                  "Where the paired / ray response acts: after_step | in_solver (default: the scene's [simulation] contact_response)")
+      ->check(CLI::IsMember({host::to_string(host::ContactResponse::kAfterStep), host::to_string(host::ContactResponse::kInSolver)}));
   sim->add_option("--seconds", options->seconds, "Simulated seconds, at most 86400 (default: the trajectory's duration)")
       ->check(CLI::PositiveNumber & CLI::Validator([](std::string& text) { return check_seconds_at_most(text, kMaxSimSeconds, "one day of simulated time"); }, "0..86400"));
   sim->add_option("--settle-seconds", options->settle_seconds, "Let the soft body settle under gravity first [s]")->check(CLI::NonNegativeNumber);

@@ -41,6 +41,13 @@ echo "earlier csv" >"$work/sim.csv"
 expect_refusal "field 'simulation.time_step_s': must be in [1e-06, 0.005] (got 0.1)" sim "$work/coarse.toml" --settle-seconds 1 --csv "$work/sim.csv"
 [[ $(cat "$work/sim.csv") == "earlier csv" ]] || bad "a refused fissure sim overwrote its --csv file"
 expect_refusal "at most 86400 s" sim spatula-sphere --seconds 1e9
+# --contact-response overrides the scene's response (and says so in the JSON), but not into
+# dropping a tool friction the scene asks for, which only in_solver solves.
+"$fissure" sim spatula-sphere --contact-response in_solver --seconds 0.02 --settle-seconds 0 --json "$work/sim.json" >/dev/null 2>&1 ||
+  bad "fissure sim --contact-response in_solver failed"
+grep -q '"contact_response": "in_solver"' "$work/sim.json" || bad "fissure sim --contact-response in_solver: the JSON does not say in_solver"
+expect_refusal "which only the in_solver response solves" sim convex-spatula-sphere --contact-response after_step --seconds 0.02
+expect_refusal "--contact-response: inside not in {after_step,in_solver}" sim spatula-sphere --contact-response inside
 
 expect_refusal "known scenes: clamp-sphere, clamp-vessel, clamp-vessel-lift, clamp-vessel-retract, convex-spatula-sphere, spatula-ball-drag, spatula-blob, spatula-fem-lobe, spatula-fissure, spatula-sphere" run no-such-scene --lockstep
 expect_refusal "looked for $PWD/scenes/no-such-scene.toml" run no-such-scene --lockstep
