@@ -145,6 +145,26 @@ SceneDescription cell_scene(const host::PlungeTool& tool, int icosphere_faces, c
   return host::plunge_cell_scene(tool, icosphere_faces, o.contact_response, o.in_solver_tool_friction);
 }
 
+// The methods a cell runs: Bullet's (and the ray method, with_ray) act on the classic soft body only.
+std::vector<SceneCollisionMethod> cell_methods(const BenchCollisionOptions& o, bool with_ray) {
+  if (o.soft_model == host::SoftBodyModel::kFem) return {SceneCollisionMethod::kPaired};
+  if (with_ray) return {SceneCollisionMethod::kBullet, SceneCollisionMethod::kRay, SceneCollisionMethod::kPaired};
+  return {SceneCollisionMethod::kBullet, SceneCollisionMethod::kPaired};
+}
+
+// What the sweep's JSON says of its ball: the shell's pose matching, or the volumetric ball's material.
+nlohmann::json sweep_body_json(const BenchCollisionOptions& o, double hold_s) {
+  nlohmann::json body = {{"plunge_depth_m", host::kPlungeDepth_m}, {"hold_s", hold_s}, {"hold_settle_s", host::kHoldSettle_s}};
+  if (o.soft_model == host::SoftBodyModel::kFem) {
+    body["model"] = "fem";
+    body["youngs_modulus_pa"] = host::kPlungeFemYoungsModulus_pa;
+  } else {
+    body["model"] = "shell";
+    body["shape_matching_ratio"] = kShapeMatchingRatio;
+  }
+  return body;
+}
+
 // ---- 1. Tunnelling sweep: speed × tool × method, on the 128-face ball and (paired) on a 1280-face icosphere.
 void print_sweep_legend(double hold_s) {
   std::printf("(hold: |F| every step for %.1f s after a %.0f ms settling window, fitted by a line; in %% of the mean force:\n"
@@ -213,18 +233,14 @@ void run_sweep(const BenchCollisionOptions& o, nlohmann::json& out) {
     std::printf("\n1. Tunnelling sweep (sphere 128 faces with pose matching kMT %.2f, 1 kHz, plunge %.0f mm, hold %.1f s)\n", kShapeMatchingRatio,
                 host::kPlungeDepth_m * 1e3, hold_s);
   }
-  out["sweep_body"] = {{"faces", 128}, {"shape_matching_ratio", kShapeMatchingRatio}, {"plunge_depth_m", host::kPlungeDepth_m}, {"hold_s", hold_s},
-                       {"hold_settle_s", host::kHoldSettle_s}};
+  out["sweep_body"] = sweep_body_json(o, hold_s);
+  out["sweep_body"]["faces"] = 128;
   print_sweep_legend(hold_s);
-  if (fem) out["sweep_body"]["youngs_modulus_pa"] = host::kPlungeFemYoungsModulus_pa;
-  // Bullet's method and the ray method act on the classic soft body only.
-  const std::vector<SceneCollisionMethod> methods =
-      fem ? std::vector<SceneCollisionMethod>{SceneCollisionMethod::kPaired}
-          : std::vector<SceneCollisionMethod>{SceneCollisionMethod::kBullet, SceneCollisionMethod::kRay, SceneCollisionMethod::kPaired};
-  out["sweep"] = sweep_cells(speeds, methods, 0, hold_s, o, "bench collision: sweep");
+  out["sweep"] = sweep_cells(speeds, cell_methods(o, /*with_ray=*/true), 0, hold_s, o, "bench collision: sweep");
   std::printf("\n1b. The same paired cells on a %d-face icosphere (issue 22's second mesh)\n", kFineSweepFaces);
-  out["sweep_fine_body"] = {{"faces", kFineSweepFaces}, {"tessellation", "icosphere"}, {"shape_matching_ratio", kShapeMatchingRatio},
-                            {"plunge_depth_m", host::kPlungeDepth_m}, {"hold_s", hold_s}, {"hold_settle_s", host::kHoldSettle_s}};
+  out["sweep_fine_body"] = sweep_body_json(o, hold_s);
+  out["sweep_fine_body"]["faces"] = kFineSweepFaces;
+  out["sweep_fine_body"]["tessellation"] = "icosphere";
   print_sweep_legend(hold_s);
   out["sweep_fine"] =
       sweep_cells(speeds, {SceneCollisionMethod::kPaired}, kFineSweepFaces, hold_s, o, "bench collision: sweep, 1280 faces");
@@ -241,10 +257,7 @@ void run_motion_cells(const BenchCollisionOptions& o, nlohmann::json& out) {
   nlohmann::json lever = nlohmann::json::array();
   for (const int faces : {0, kFineSweepFaces}) {
     const SceneDescription scene = cell_scene(host::plunge_tools()[2], faces, o);
-    const std::vector<SceneCollisionMethod> methods = o.soft_model == host::SoftBodyModel::kFem
-                                                          ? std::vector<SceneCollisionMethod>{SceneCollisionMethod::kPaired}
-                                                          : std::vector<SceneCollisionMethod>{SceneCollisionMethod::kBullet, SceneCollisionMethod::kPaired};
-    for (SceneCollisionMethod method : methods) {
+    for (SceneCollisionMethod method : cell_methods(o, /*with_ray=*/false)) {
       const host::LeverResult r = host::run_lever_hold(scene, method, hold_s);
       const int mesh = faces == 0 ? 128 : faces;
       std::printf("%-8d %-7s | %7d %7d %9.3f | %9d %8d %8d %9.3f | %9.3f %9.3f\n", mesh, host::to_string(method), r.crossed_nodes, r.inside_nodes,

@@ -53,6 +53,24 @@ SceneDescription plunge_cell_scene(const PlungeTool& tool, int icosphere_faces, 
   return scene;
 }
 
+namespace {
+
+// The plunge ball's bed: every node within kPlungeBedTop_m of the ground tied to it.
+SoftAnchorBox plunge_bed(const GroundDescription& ground) {
+  SoftAnchorBox bed;
+  bed.min_world_m = {-1.0, ground.top_height_m - 1.0, -1.0};
+  bed.max_world_m = {1.0, ground.top_height_m + kPlungeBedTop_m, 1.0};
+  return bed;
+}
+
+// The in-solver cells' tool friction, or none.
+void set_plunge_friction(ToolDescription& tool, bool friction) {
+  tool.friction_static_ratio = friction ? kPlungeFrictionStaticRatio : 0.0;
+  tool.friction_kinetic_ratio = friction ? kPlungeFrictionKineticRatio : 0.0;
+}
+
+}  // namespace
+
 SceneDescription volumetric_plunge_scene(SceneDescription scene, int icosphere_faces, ContactResponse response, bool tool_friction) {
   if (icosphere_faces != 0 && icosphere_faces != 1280)
     throw std::invalid_argument("the volumetric sweep ball is the 128-face shell's (icosphere_faces 0) or the 1280-face icosphere's, got " +
@@ -77,26 +95,17 @@ SceneDescription volumetric_plunge_scene(SceneDescription scene, int icosphere_f
   const SoftBodyDescription& shell = scene.soft_bodies.front();
   soft.friction_ratio = shell.friction_ratio;
   soft.collision_margin_m = shell.collision_margin_m;
-  SoftAnchorBox bed;
-  bed.min_world_m = {-1.0, scene.ground.top_height_m - 1.0, -1.0};
-  bed.max_world_m = {1.0, scene.ground.top_height_m + kPlungeBedTop_m, 1.0};
-  soft.anchors.push_back(bed);
+  soft.anchors.push_back(plunge_bed(scene.ground));
   scene.soft_bodies = {std::move(soft)};
   scene.simulation.contact_response = response;
-  const bool friction = response == ContactResponse::kInSolver && tool_friction;
-  scene.tool.friction_static_ratio = friction ? kPlungeFrictionStaticRatio : 0.0;
-  scene.tool.friction_kinetic_ratio = friction ? kPlungeFrictionKineticRatio : 0.0;
+  set_plunge_friction(scene.tool, response == ContactResponse::kInSolver && tool_friction);
   return scene;
 }
 
 SceneDescription in_solver_plunge_scene(SceneDescription scene, bool tool_friction) {
   scene.simulation.contact_response = ContactResponse::kInSolver;
-  scene.tool.friction_static_ratio = tool_friction ? kPlungeFrictionStaticRatio : 0.0;
-  scene.tool.friction_kinetic_ratio = tool_friction ? kPlungeFrictionKineticRatio : 0.0;
-  SoftAnchorBox bed;
-  bed.min_world_m = {-1.0, scene.ground.top_height_m - 1.0, -1.0};
-  bed.max_world_m = {1.0, scene.ground.top_height_m + kPlungeBedTop_m, 1.0};
-  scene.soft_bodies.front().anchors.push_back(bed);
+  set_plunge_friction(scene.tool, tool_friction);
+  scene.soft_bodies.front().anchors.push_back(plunge_bed(scene.ground));
   return scene;
 }
 
